@@ -1,0 +1,24 @@
+# Every target of ours links neuflow::options; third-party code never sees these flags.
+add_library(neuflow_options INTERFACE)
+add_library(neuflow::options ALIAS neuflow_options)
+
+target_compile_options(neuflow_options INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast -Wcast-align
+  -Woverloaded-virtual -Wformat=2 -Wimplicit-fallthrough
+  # GCC 12 reports -Wrestrict inside libstdc++'s own std::string code at -O3 (GCC bug 105329).
+  -Wno-restrict
+  $<$<BOOL:${NEUFLOW_WERROR}>:-Werror>)
+# Not enabled: -Wnull-dereference (false positives on GCC 12 at -O3) and -Wdouble-promotion
+# (numeric code here deliberately accumulates floats in double).
+
+# AVX2+FMA are the floor of the deployment targets we measure on; the Jetson (aarch64) build
+# takes the compiler's default there.
+if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
+  target_compile_options(neuflow_options INTERFACE -mavx2 -mfma -mf16c)
+endif()
+
+if(NEUFLOW_SANITIZE)
+  target_compile_options(neuflow_options INTERFACE
+    -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(neuflow_options INTERFACE -fsanitize=address,undefined)
+endif()

@@ -1,0 +1,73 @@
+#pragma once
+// Computing flow with a loaded model: for a pair of images, or frame by frame on a stream,
+// where each frame's backbone features are computed once and reused for the next pair.
+// A session is used by one thread at a time; several sessions may share one FlowModel.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+
+#include "neuflow/flow/flow_field.hpp"
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/stage_observer.hpp"
+
+namespace neuflow::model {
+
+enum class ChannelOrder { rgb, bgr };
+
+// An 8-bit, 3-channel interleaved image; `stride` is the number of bytes between rows.
+struct ImageView {
+  const std::uint8_t* data = nullptr;
+  int width = 0;
+  int height = 0;
+  std::ptrdiff_t stride = 0;
+  ChannelOrder order = ChannelOrder::rgb;  // the networks were trained on RGB
+};
+
+struct Iterations {
+  int s16 = 1;  // refinement iterations at 1/16
+  int s8 = 8;   // refinement iterations at 1/8
+};
+
+struct SessionOptions {
+  Iterations iterations;
+  // 0 × 0: run at the input's own size, edge-padded to multiples of 16 and cropped back.
+  // Otherwise resize the input to this size (multiples of 16, at least 32) and the flow back,
+  // rescaling its vectors to input pixels.
+  int model_width = 0;
+  int model_height = 0;
+  int threads = 0;  // 0: OpenMP's default (all cores)
+};
+
+class FlowSession {
+ public:
+  explicit FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions options = {});
+  ~FlowSession();
+  FlowSession(const FlowSession&) = delete;
+  FlowSession& operator=(const FlowSession&) = delete;
+
+  // Flow from frame0 to frame1 at frame0's size (both must have the same size). Does not
+  // touch the stream state. Throws std::invalid_argument for unusable images.
+  flow::FlowField compute(const ImageView& frame0, const ImageView& frame1);
+  flow::FlowField compute(const ImageView& frame0, const ImageView& frame1, const Iterations& iterations);
+
+  // Streaming: the flow from the previous frame to this one, or nothing for the first frame
+  // (and the first after reset() or a change of frame size).
+  std::optional<flow::FlowField> push(const ImageView& frame);
+  std::optional<flow::FlowField> push(const ImageView& frame, const Iterations& iterations);
+  void reset();
+
+  // Sees every intermediate of subsequent passes (for reference comparisons).
+  void set_observer(StageObserver observer);
+
+  const SessionOptions& options() const { return options_; }
+
+  struct State;  // opaque per-session buffers and stream state
+
+ private:
+  SessionOptions options_;
+  std::shared_ptr<const FlowModel> model_;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace neuflow::model

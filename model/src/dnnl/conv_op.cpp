@@ -1,0 +1,112 @@
+#include "dnnl/conv_op.hpp"
+
+#include <cstring>
+#include <stdexcept>
+
+#include "dnnl/context.hpp"
+
+namespace neuflow::model {
+
+using dnnl::memory;
+using tag = dnnl::memory::format_tag;
+using dt = dnnl::memory::data_type;
+
+namespace {
+
+dnnl::primitive_attr make_attr(const ConvParams& p) {
+  dnnl::post_ops ops;
+  if (p.accumulate) ops.append_sum(1.f);
+  switch (p.activation) {
+    case Activation::none: break;
+    case Activation::leaky_relu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.1f, 0.f); break;
+    case Activation::relu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.f, 0.f); break;
+    case Activation::gelu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_gelu_erf, 0.f, 0.f); break;
+  }
+  dnnl::primitive_attr attr;
+  attr.set_post_ops(ops);
+  return attr;
+}
+
+}  // namespace
+
+ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& input,
+               std::optional<memory::desc> output)
+    : accumulate_(p.accumulate) {
+  const auto& eng = cpu_engine();
+  const auto dims = input.dims();  // {1, C, H, W}
+  if (dims.size() != 4 || dims[1] != w.in_channels) {
+    throw std::logic_error("ConvOp: input channels do not match the weights");
+  }
+  const int in_h = static_cast<int>(dims[2]);
+  const int in_w = static_cast<int>(dims[3]);
+  out_c_ = w.out_channels;
+  out_h_ = (in_h + 2 * p.pad - w.kernel_h) / p.stride + 1;
+  out_w_ = (in_w + 2 * p.pad - w.kernel_w) / p.stride + 1;
+
+  const memory::dims src_dims{1, w.in_channels, in_h, in_w};
+  const memory::dims wei_dims{w.out_channels, w.in_channels, w.kernel_h, w.kernel_w};
+  const memory::dims dst_dims{1, out_c_, out_h_, out_w_};
+  const memory::desc src_any(src_dims, dt::f32, tag::any);
+  const memory::desc wei_any(wei_dims, dt::f32, tag::any);
+  const memory::desc dst_md = output ? *output : memory::desc(dst_dims, dt::f32, tag::any);
+  const memory::desc bias_md = w.bias.empty() ? memory::desc() : memory::desc({out_c_}, dt::f32, tag::x);
+
+  const auto desc = dnnl::convolution_forward::desc(
+      dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, src_any, wei_any, bias_md,
+      dst_md, {p.stride, p.stride}, {p.pad, p.pad}, {p.pad, p.pad});
+  const dnnl::convolution_forward::primitive_desc pd(desc, make_attr(p), eng);
+  conv_ = dnnl::convolution_forward(pd);
+
+  // Weights: reorder once from the checkpoint's OIHW into the primitive's layout.
+  dnnl::stream s(eng);
+  memory user_w({wei_dims, dt::f32, tag::oihw}, eng, const_cast<float*>(w.weight.data()));
+  weights_ = memory(pd.weights_desc(), eng);
+  dnnl::reorder(user_w, weights_).execute(s, user_w, weights_);
+  if (!w.bias.empty()) {
+    bias_ = memory(bias_md, eng);
+    std::memcpy(bias_.get_data_handle(), w.bias.data(), w.bias.size() * sizeof(float));
+  }
+  s.wait();
+
+  dst_ = memory(pd.dst_desc(), eng);
+  if (pd.src_desc() != input) {
+    reordered_input_ = memory(pd.src_desc(), eng);
+    input_reorder_ = dnnl::reorder(dnnl::reorder::primitive_desc(eng, input, eng, pd.src_desc()));
+  }
+}
+
+const memory& ConvOp::run(dnnl::stream& stream, const memory& input, const memory* addend) {
+  if (accumulate_ != (addend != nullptr)) throw std::logic_error("ConvOp: addend given iff accumulate");
+  const memory* src = &input;
+  if (input_reorder_) {
+    memory in = input;  // a handle copy: reorder::execute takes non-const handles
+    input_reorder_->execute(stream, in, reordered_input_);
+    src = &reordered_input_;
+  }
+  if (addend) {
+    std::memcpy(dst_.get_data_handle(), addend->get_data_handle(), dst_.get_desc().get_size());
+  }
+  std::unordered_map<int, memory> args{{DNNL_ARG_SRC, *src}, {DNNL_ARG_WEIGHTS, weights_}, {DNNL_ARG_DST, dst_}};
+  if (bias_) args.emplace(DNNL_ARG_BIAS, bias_);
+  conv_.execute(stream, args);
+  return dst_;
+}
+
+void ConvOp::run_to_nhwc(dnnl::stream& stream, const memory& input, Tensor& out, const memory* addend) {
+  run(stream, input, addend);
+  if (out.h != out_h_ || out.w != out_w_ || out.c != out_c_) out.resize(out_h_, out_w_, out_c_);
+  memory out_mem(nhwc_desc(out_h_, out_w_, out_c_), cpu_engine(), out.data.data());
+  if (!nhwc_reorder_) nhwc_reorder_ = dnnl::reorder(dst_, out_mem);
+  nhwc_reorder_->execute(stream, dst_, out_mem);
+}
+
+void to_nhwc(dnnl::stream& stream, const memory& src, Tensor& out) {
+  const auto dims = src.get_desc().dims();
+  const int c = static_cast<int>(dims[1]), h = static_cast<int>(dims[2]), w = static_cast<int>(dims[3]);
+  if (out.h != h || out.w != w || out.c != c) out.resize(h, w, c);
+  memory out_mem(nhwc_desc(h, w, c), cpu_engine(), out.data.data());
+  memory in = src;
+  dnnl::reorder(in, out_mem).execute(stream, in, out_mem);
+}
+
+}  // namespace neuflow::model

@@ -1,0 +1,89 @@
+#include "frame_geometry.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <stdexcept>
+#include <string>
+
+namespace neuflow::model {
+
+namespace {
+constexpr int kMultiple = 16;
+constexpr int kMinSize = 32;
+constexpr int kMaxSize = 16384;
+
+int round_up(int v, int m) { return (v + m - 1) / m * m; }
+}  // namespace
+
+FrameGeometry plan_geometry(int input_width, int input_height, const SessionOptions& options) {
+  if (input_width < kMinSize || input_height < kMinSize || input_width > kMaxSize || input_height > kMaxSize) {
+    throw std::invalid_argument("frame size " + std::to_string(input_width) + "x" + std::to_string(input_height) +
+                                " is outside the supported range 32x32 to 16384x16384");
+  }
+  FrameGeometry g;
+  g.input_width = input_width;
+  g.input_height = input_height;
+  if (options.model_width > 0 || options.model_height > 0) {
+    if (options.model_width % kMultiple || options.model_height % kMultiple || options.model_width < kMinSize ||
+        options.model_height < kMinSize || options.model_width > kMaxSize || options.model_height > kMaxSize) {
+      throw std::invalid_argument("model size " + std::to_string(options.model_width) + "x" +
+                                  std::to_string(options.model_height) +
+                                  " must be multiples of 16, at least 32x32 (or 0x0 for the input's own size)");
+    }
+    g.resize = true;
+    g.model_width = options.model_width;
+    g.model_height = options.model_height;
+  } else {
+    g.model_width = round_up(input_width, kMultiple);
+    g.model_height = round_up(input_height, kMultiple);
+    g.pad_left = (g.model_width - input_width) / 2;
+    g.pad_top = (g.model_height - input_height) / 2;
+  }
+  return g;
+}
+
+void prepare_input(const ImageView& image, const FrameGeometry& g, Tensor& out) {
+  if (image.data == nullptr || image.width != g.input_width || image.height != g.input_height ||
+      image.stride < static_cast<std::ptrdiff_t>(image.width) * 3) {
+    throw std::invalid_argument("image does not match the session's frame size or has a short row stride");
+  }
+  const cv::Mat src(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.data),
+                    static_cast<std::size_t>(image.stride));
+  cv::Mat rgb;
+  if (image.order == ChannelOrder::bgr) {
+    cv::cvtColor(src, rgb, cv::COLOR_BGR2RGB);
+  } else {
+    rgb = src;
+  }
+  cv::Mat sized;
+  if (g.resize) {
+    cv::resize(rgb, sized, cv::Size(g.model_width, g.model_height), 0, 0, cv::INTER_LINEAR);
+  } else {
+    cv::copyMakeBorder(rgb, sized, g.pad_top, g.model_height - g.input_height - g.pad_top, g.pad_left,
+                       g.model_width - g.input_width - g.pad_left, cv::BORDER_REPLICATE);
+  }
+  out.resize(g.model_height, g.model_width, 3);
+  cv::Mat dst(g.model_height, g.model_width, CV_32FC3, out.data.data());
+  sized.convertTo(dst, CV_32FC3, 1.0 / 255.0);
+}
+
+flow::FlowField restore_flow(const Tensor& model_flow, const FrameGeometry& g) {
+  flow::FlowField f(g.input_width, g.input_height);
+  const cv::Mat src(model_flow.h, model_flow.w, CV_32FC2, const_cast<float*>(model_flow.data.data()));
+  cv::Mat dst(g.input_height, g.input_width, CV_32FC2, f.uv.data());
+  if (g.resize) {
+    cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_LINEAR);
+    const float sx = static_cast<float>(g.input_width) / static_cast<float>(g.model_width);
+    const float sy = static_cast<float>(g.input_height) / static_cast<float>(g.model_height);
+    for (std::size_t p = 0; p < f.pixel_count(); ++p) {
+      f.uv[2 * p] *= sx;
+      f.uv[2 * p + 1] *= sy;
+    }
+  } else {
+    src(cv::Rect(g.pad_left, g.pad_top, g.input_width, g.input_height)).copyTo(dst);
+  }
+  return f;
+}
+
+}  // namespace neuflow::model

@@ -1,0 +1,94 @@
+#include "network.hpp"
+
+#include <string>
+
+#include "ops/feature_ops.hpp"
+
+namespace neuflow::model {
+
+namespace {
+
+constexpr int kContext = kContextChannels;  // channels 0..63 are context, 64.. are features
+constexpr int kFeatures = 128;
+
+void observe(const StageObserver* observer, const std::string& name, int frame, const Tensor& t) {
+  if (observer && *observer) (*observer)(StageTensor{name, frame, t.h, t.w, t.c, t.data.data()});
+}
+
+ChannelSlice features_of(const Tensor& t) { return {&t, kContext, kFeatures}; }
+ChannelSlice context_of(const Tensor& t) { return {&t, 0, kContext}; }
+
+}  // namespace
+
+NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width)
+    : height_(height),
+      width_(width),
+      encoder_(w, height, width),
+      attention_(w, height / 16, width / 16),
+      matching_(height / 16, width / 16, kFeatures),
+      refine_s16_(w.refine_s16, height / 16, width / 16),
+      merge_(w, height / 8, width / 8),
+      refine_s8_(w.refine_s8, height / 8, width / 8),
+      upsampler_(w, height / 8, width / 8),
+      context16_(height / 16, width / 16, kContext),
+      flow8_(height / 8, width / 8, 2) {}
+
+void NetworkPlan::encode(dnnl::stream& stream, const Tensor& image, FrameFeatures& out) {
+  encoder_.run(stream, image, out);
+  stream.wait();
+}
+
+void NetworkPlan::flow(dnnl::stream& stream, const FrameFeatures& f0, const FrameFeatures& f1, int iters_s16,
+                       int iters_s8, Tensor& out, const StageObserver* observer) {
+  observe(observer, "backbone_s16", 0, f0.f16);
+  observe(observer, "backbone_s16", 1, f1.f16);
+  observe(observer, "backbone_s8", 0, f0.f8);
+  observe(observer, "backbone_s8", 1, f1.f8);
+  observe(observer, "conv_s8", 0, f0.upsample_features);
+
+  // 1/16: cross-attention, global matching, refinement.
+  attention_.run(stream, f0.f16, f1.f16, attended0_, attended1_);
+  observe(observer, "cross_attn_s16", 0, attended0_);
+  observe(observer, "cross_attn_s16", 1, attended1_);
+
+  matching_.run(stream, features_of(attended0_), features_of(attended1_), flow16_);
+  observe(observer, "global_matching_flow", 0, flow16_);
+
+  copy_channels(context_of(attended0_), context16_, 0, /*relu=*/true);
+  refine_s16_.begin(stream, context16_);
+  for (int i = 0; i < iters_s16; ++i) {
+    refine_s16_.step(stream, features_of(attended0_), features_of(attended1_), flow16_);
+    const std::string it = "_iter" + std::to_string(i);
+    if (observer) {
+      observe(observer, "corr_s16" + it, 0, extract_channels({&refine_s16_.last_input(), 0, kCorrChannels}));
+      observe(observer, "refine_s16" + it + "_hidden", 0, refine_s16_.hidden());
+      observe(observer, "refine_s16" + it + "_delta", 0, refine_s16_.delta());
+    }
+  }
+
+  // 1/16 → 1/8.
+  upsample_nearest_2x(all_channels(flow16_), flow8_, 0, 2.f);
+  merge_.merge_features(stream, features_of(f0.f8), features_of(attended0_), features8_0_);
+  merge_.merge_features(stream, features_of(f1.f8), features_of(attended1_), features8_1_);
+  observe(observer, "merge_s8", 0, features8_0_);
+  observe(observer, "merge_s8", 1, features8_1_);
+  merge_.merge_context(stream, context_of(f0.f8), context_of(attended0_), context8_);
+  observe(observer, "context_merge_s8", 0, context8_);
+
+  // 1/8 refinement.
+  refine_s8_.begin(stream, context8_);
+  for (int i = 0; i < iters_s8; ++i) {
+    refine_s8_.step(stream, all_channels(features8_0_), all_channels(features8_1_), flow8_);
+    const std::string it = "_iter" + std::to_string(i);
+    if (observer) {
+      observe(observer, "corr_s8" + it, 0, extract_channels({&refine_s8_.last_input(), 0, kCorrChannels}));
+      observe(observer, "refine_s8" + it + "_hidden", 0, refine_s8_.hidden());
+      observe(observer, "refine_s8" + it + "_delta", 0, refine_s8_.delta());
+    }
+  }
+
+  upsampler_.run(stream, flow8_, f0.upsample_features, out);
+  observe(observer, "flow", 0, out);
+}
+
+}  // namespace neuflow::model

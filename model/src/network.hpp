@@ -1,0 +1,45 @@
+#pragma once
+// The whole forward pass at one model resolution: every primitive and buffer is created once
+// here and reused for every pair of that size.
+#include <dnnl.hpp>
+
+#include "neuflow/model/stage_observer.hpp"
+#include "stages/convex_upsampler.hpp"
+#include "stages/cross_attention.hpp"
+#include "stages/frame_encoder.hpp"
+#include "stages/global_matching.hpp"
+#include "stages/refinement.hpp"
+#include "stages/scale_merge.hpp"
+#include "tensor.hpp"
+#include "weights.hpp"
+
+namespace neuflow::model {
+
+class NetworkPlan {
+ public:
+  // height, width: multiples of 16, at least 32.
+  NetworkPlan(const NetworkWeights& weights, int height, int width);
+
+  int height() const { return height_; }
+  int width() const { return width_; }
+
+  // image: [height, width, 3] RGB in 0..1.
+  void encode(dnnl::stream& stream, const Tensor& image, FrameFeatures& out);
+
+  // Flow from frame 0 to frame 1 at model resolution: [height, width, 2] (u, v) in pixels.
+  void flow(dnnl::stream& stream, const FrameFeatures& frame0, const FrameFeatures& frame1, int iters_s16,
+            int iters_s8, Tensor& out, const StageObserver* observer = nullptr);
+
+ private:
+  int height_, width_;
+  FrameEncoder encoder_;
+  CrossAttention attention_;
+  GlobalMatching matching_;
+  Refinement refine_s16_;
+  ScaleMerge merge_;
+  Refinement refine_s8_;
+  ConvexUpsampler upsampler_;
+  Tensor attended0_, attended1_, context16_, flow16_, flow8_, features8_0_, features8_1_, context8_;
+};
+
+}  // namespace neuflow::model

@@ -1,0 +1,93 @@
+#include "stages/cross_attention.hpp"
+
+#include <algorithm>
+
+#include "dnnl/matrix_ops.hpp"
+#include "ops/layer_norm.hpp"
+
+namespace neuflow::model {
+
+namespace {
+constexpr int kDim = 192;
+// Query rows per attention block: bounds the score block to ~4M floats at any resolution.
+constexpr int kScoreBlockFloats = 1 << 22;
+
+MatrixView rows(const float* data, int n, int cols, int ld) { return {data, n, cols, ld}; }
+}  // namespace
+
+CrossAttention::CrossAttention(const NetworkWeights& weights, int h16, int w16)
+    : weights_(weights), tokens_(h16 * w16) {
+  block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
+  const std::size_t l = tokens_;
+  q_.resize(l * kDim);
+  k_.resize(l * kDim);
+  v_.resize(l * kDim);
+  scores_.resize(static_cast<std::size_t>(block_rows_) * l);
+  message_.resize(l * kDim);
+  mlp_in_.resize(l * 2 * kDim);
+  mlp_hidden_.resize(l * 2 * kDim);
+  state0_.resize(l * kDim);
+  state1_.resize(l * kDim);
+}
+
+void CrossAttention::layer(dnnl::stream& stream, const AttentionLayerWeights& w, const float* src,
+                           const float* tgt, float* out) {
+  const int l = tokens_;
+  const auto linear = [&](const float* in, int in_dim, const LinearWeights& lw, float* dst, bool gelu) {
+    matmul(stream, rows(in, l, in_dim, in_dim), rows(lw.weight.data(), lw.out_features, lw.in_features, lw.in_features),
+           dst, lw.out_features, {.transpose_b = true, .bias = lw.bias.empty() ? nullptr : lw.bias.data(), .gelu = gelu});
+  };
+  linear(src, kDim, w.q_proj, q_.data(), false);  // already scaled by 1/sqrt(192)
+  linear(tgt, kDim, w.k_proj, k_.data(), false);
+  linear(tgt, kDim, w.v_proj, v_.data(), false);
+
+  for (int r0 = 0; r0 < l; r0 += block_rows_) {
+    const int n = std::min(block_rows_, l - r0);
+    matmul(stream, rows(q_.data() + static_cast<std::size_t>(r0) * kDim, n, kDim, kDim), rows(k_.data(), l, kDim, kDim),
+           scores_.data(), l, {.transpose_b = true});
+    softmax_rows(stream, scores_.data(), n, l);
+    matmul(stream, rows(scores_.data(), n, l, l), rows(v_.data(), l, kDim, kDim),
+           message_.data() + static_cast<std::size_t>(r0) * kDim, kDim);
+  }
+
+  // mlp input = concat[src, LayerNorm1(merge(message))]; q_ is free again and holds the merge.
+  linear(message_.data(), kDim, w.merge, q_.data(), false);
+  stream.wait();
+  layer_norm_rows(q_.data(), l, kDim, w.norm1.gamma, w.norm1.beta);
+#pragma omp parallel for
+  for (int t = 0; t < l; ++t) {
+    float* row = mlp_in_.data() + static_cast<std::size_t>(t) * 2 * kDim;
+    std::copy_n(src + static_cast<std::size_t>(t) * kDim, kDim, row);
+    std::copy_n(q_.data() + static_cast<std::size_t>(t) * kDim, kDim, row + kDim);
+  }
+
+  linear(mlp_in_.data(), 2 * kDim, w.mlp0, mlp_hidden_.data(), true);
+  linear(mlp_hidden_.data(), 2 * kDim, w.mlp2, message_.data(), false);
+  stream.wait();
+  layer_norm_rows(message_.data(), l, kDim, w.norm2.gamma, w.norm2.beta);
+  const std::size_t total = static_cast<std::size_t>(l) * kDim;
+#pragma omp parallel for
+  for (std::size_t i = 0; i < total; ++i) out[i] = src[i] + message_[i];
+}
+
+void CrossAttention::run(dnnl::stream& stream, const Tensor& f16_0, const Tensor& f16_1, Tensor& out0,
+                         Tensor& out1) {
+  out0.resize(f16_0.h, f16_0.w, kDim);
+  out1.resize(f16_1.h, f16_1.w, kDim);
+  // Layer 0 reads the backbone features, layer 1 reads layer 0's outputs of both frames.
+  layer(stream, weights_.attention[0], f16_0.data.data(), f16_1.data.data(), state0_.data());
+  layer(stream, weights_.attention[0], f16_1.data.data(), f16_0.data.data(), state1_.data());
+  layer(stream, weights_.attention[1], state0_.data(), state1_.data(), out0.data.data());
+  layer(stream, weights_.attention[1], state1_.data(), state0_.data(), out1.data.data());
+
+  const auto& scale = weights_.attention_norm_scale;
+  const auto& shift = weights_.attention_norm_shift;
+  for (Tensor* t : {&out0, &out1}) {
+    for (std::size_t p = 0; p < t->pixels(); ++p) {
+      float* x = t->data.data() + p * kDim;
+      for (int c = 0; c < kDim; ++c) x[c] = x[c] * scale[c] + shift[c];
+    }
+  }
+}
+
+}  // namespace neuflow::model

@@ -1,0 +1,70 @@
+#include "stages/refinement.hpp"
+
+#include <algorithm>
+
+#include "dnnl/context.hpp"
+#include "ops/local_correlation.hpp"
+
+namespace neuflow::model {
+
+namespace {
+constexpr int kHiddenOffset = kCorrChannels;
+constexpr int kFlowOffset = kCorrChannels + kHiddenChannels;
+constexpr float kHiddenClamp = 4.f;
+}  // namespace
+
+Refinement::Refinement(const RefineWeights& w, int h, int width)
+    : input_(h, width, kRefineDynamicChannels),
+      constant_(h, width, kRefineConstantChannels),
+      hidden_(h, width, kHiddenChannels),
+      delta_(h, width, 2) {
+  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c));
+  conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c),
+                          conv1_->output_desc());
+  conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, conv1_->output_desc());
+  const ConvOp* prev = &*conv2_;
+  for (std::size_t i = 0; i < layers_.size(); ++i) {
+    layers_[i].emplace(w.conv_layers[i], ConvParams{1, 1, Activation::leaky_relu}, prev->output_desc());
+    prev = &*layers_[i];
+  }
+  conv3_.emplace(w.conv3, ConvParams{1, 1, Activation::none}, prev->output_desc());
+}
+
+void Refinement::begin(dnnl::stream& stream, const Tensor& context) {
+  copy_channels(all_channels(context), constant_, 0);
+  for (std::size_t p = 0; p < constant_.pixels(); ++p) constant_.data[p * constant_.c + kContextChannels] = kCorrRadiusPlane;
+  conv1_constant_->run(stream, wrap_nhwc(constant_));
+  std::fill(hidden_.data.begin(), hidden_.data.end(), 0.f);
+  for (std::size_t p = 0; p < input_.pixels(); ++p) {
+    std::fill_n(input_.data.data() + p * input_.c + kHiddenOffset, kHiddenChannels, 0.f);
+  }
+  stream.wait();
+}
+
+void Refinement::step(dnnl::stream& stream, const ChannelSlice& f0, const ChannelSlice& f1, Tensor& flow) {
+  local_correlation(f0, f1, flow, input_, 0);
+  copy_channels(all_channels(flow), input_, kFlowOffset);
+
+  const auto& x1 = conv1_->run(stream, wrap_nhwc(input_), &conv1_constant_->output());
+  const dnnl::memory* x = &conv2_->run(stream, x1);
+  for (auto& layer : layers_) x = &layer->run(stream, *x);
+  conv3_->run_to_nhwc(stream, *x, output_);
+  stream.wait();
+
+  const int hw = static_cast<int>(input_.pixels());
+#pragma omp parallel for
+  for (int p = 0; p < hw; ++p) {
+    const float* o = output_.data.data() + static_cast<std::size_t>(p) * output_.c;
+    float* hid = hidden_.data.data() + static_cast<std::size_t>(p) * kHiddenChannels;
+    float* in_hid = input_.data.data() + static_cast<std::size_t>(p) * input_.c + kHiddenOffset;
+    for (int c = 0; c < kHiddenChannels; ++c) {
+      hid[c] = in_hid[c] = std::clamp(o[2 + c], -kHiddenClamp, kHiddenClamp);
+    }
+    delta_.data[2 * p] = o[0];
+    delta_.data[2 * p + 1] = o[1];
+    flow.data[2 * p] += o[0];
+    flow.data[2 * p + 1] += o[1];
+  }
+}
+
+}  // namespace neuflow::model

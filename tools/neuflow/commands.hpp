@@ -1,0 +1,31 @@
+#pragma once
+// Each subcommand of `neuflow` lives in its own cmd_*.cpp and registers itself on the app
+// through one of the functions below; main.cpp calls them all.
+#include <CLI/CLI.hpp>
+
+#include <stdexcept>
+#include <string>
+
+namespace neuflow::cli {
+
+// Exit codes (sysexits.h) for the classes a script may want to tell apart; bad usage is
+// reported by CLI11 with its own codes.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitDataError = 65;   // EX_DATAERR: an input file is malformed
+inline constexpr int kExitNoInput = 66;     // EX_NOINPUT: an input file is missing or unreadable
+inline constexpr int kExitCantCreate = 73;  // EX_CANTCREAT: an output could not be written
+
+// Thrown from a subcommand's callback: main prints "neuflow <sub>: <message>" and exits
+// with exit_code.
+struct CommandError : std::runtime_error {
+  CommandError(int code, const std::string& message) : std::runtime_error(message), exit_code(code) {}
+  int exit_code;
+};
+
+// Registration functions, one per cmd_*.cpp.
+void register_viz(CLI::App& app);
+void register_compare(CLI::App& app);
+void register_inspect(CLI::App& app);
+
+}  // namespace neuflow::cli

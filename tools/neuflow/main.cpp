@@ -1,0 +1,31 @@
+// neuflow: NeuFlow-V2 optical flow from the command line.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"neuflow: NeuFlow-V2 optical flow on the CPU"};
+  app.set_version_flag("--version", std::string("neuflow ") + NEUFLOW_VERSION);
+  app.require_subcommand(1);
+
+  neuflow::cli::register_viz(app);
+  neuflow::cli::register_compare(app);
+  neuflow::cli::register_inspect(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const neuflow::cli::CommandError& e) {
+    std::fprintf(stderr, "neuflow: %s\n", e.what());
+    return e.exit_code;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "neuflow: %s\n", e.what());
+    return neuflow::cli::kExitFailure;
+  }
+  return neuflow::cli::kExitOk;
+}
