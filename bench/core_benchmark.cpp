@@ -1,0 +1,208 @@
+// Benchmarks of the NeuFlow-V2 core: per pair and per streamed frame at the sizes of the
+// reference measurements, with achieved GFLOP/s as a fraction of the sgemm peak measured in
+// the same process (absolute times on a shared machine drift; the ratio does not).
+//
+//   neuflow-bench-core [--model CKPT] [--threads N] [--sizes 320x256,768x432] [benchmark flags]
+//
+// Peak RSS is per process: run one size per process for per-size peaks (bench/run-core.sh).
+#include <benchmark/benchmark.h>
+#include <oneapi/dnnl/dnnl.h>
+#include <omp.h>
+#include <sys/resource.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/flow_session.hpp"
+#include "neuflow/model/network_cost.hpp"
+
+namespace {
+
+using neuflow::model::FlowModel;
+using neuflow::model::FlowSession;
+using neuflow::model::ImageView;
+
+struct Config {
+  std::filesystem::path model;
+  std::filesystem::path frames;
+  int threads = 2;
+  std::vector<std::pair<int, int>> sizes{{320, 256}, {512, 384}, {768, 432}, {1024, 448}};
+};
+
+Config g_config;
+double g_sgemm_peak_gflops = 0;
+std::shared_ptr<const FlowModel> g_model;
+
+double peak_rss_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+// sgemm at a size large enough to reach the machine's peak; the best of several runs.
+void BM_SgemmPeak(benchmark::State& state) {
+  omp_set_num_threads(g_config.threads);
+  const int n = static_cast<int>(state.range(0));
+  std::vector<float> a(static_cast<std::size_t>(n) * n, 1.f), b(a.size(), 0.5f), c(a.size());
+  double best = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    dnnl_sgemm('N', 'N', n, n, n, 1.f, a.data(), n, b.data(), n, 0.f, c.data(), n);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    best = std::max(best, 2.0 * n * n * n / s / 1e9);
+    benchmark::DoNotOptimize(c.data());
+  }
+  g_sgemm_peak_gflops = std::max(g_sgemm_peak_gflops, best);
+  state.counters["GFLOP/s"] = best;
+}
+
+std::vector<cv::Mat> load_frames(int width, int height) {
+  std::vector<std::filesystem::path> files;
+  if (std::filesystem::is_directory(g_config.frames)) {
+    for (const auto& e : std::filesystem::directory_iterator(g_config.frames)) {
+      if (e.path().extension() == ".jpg" || e.path().extension() == ".png") files.push_back(e.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<cv::Mat> frames;
+  for (const auto& f : files) {
+    cv::Mat img = cv::imread(f.string(), cv::IMREAD_COLOR), resized;
+    if (img.empty()) continue;
+    cv::resize(img, resized, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+    frames.push_back(resized);
+  }
+  if (frames.size() < 2) {  // no fixture frames: a moving gradient stands in
+    frames.clear();
+    for (int i = 0; i < 4; ++i) {
+      cv::Mat m(height, width, CV_8UC3);
+      for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) m.at<cv::Vec3b>(y, x) = cv::Vec3b((x + 3 * i) & 255, y & 255, (x ^ y) & 255);
+      frames.push_back(m);
+    }
+  }
+  return frames;
+}
+
+ImageView view(const cv::Mat& m) {
+  return {m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), neuflow::model::ChannelOrder::bgr};
+}
+
+void report(benchmark::State& state, double seconds_per_item, double flops) {
+  const double gflops = flops / seconds_per_item / 1e9;
+  state.counters["ms"] = seconds_per_item * 1e3;
+  state.counters["GFLOP/s"] = gflops;
+  state.counters["of_sgemm_peak"] = g_sgemm_peak_gflops > 0 ? gflops / g_sgemm_peak_gflops : 0;
+  state.counters["peak_rss_MB"] = peak_rss_mb();
+}
+
+void BM_Pair(benchmark::State& state, int width, int height) {
+  FlowSession session(g_model, {.threads = g_config.threads});
+  const auto frames = load_frames(width, height);
+  session.compute(view(frames[0]), view(frames[1]));  // warm-up: primitives and buffers
+  double total = 0;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto f = session.compute(view(frames[i % frames.size()]), view(frames[(i + 1) % frames.size()]));
+    total += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    benchmark::DoNotOptimize(f.uv.data());
+    ++i;
+  }
+  report(state, total / static_cast<double>(state.iterations()), neuflow::model::network_cost(height, width).pair());
+}
+
+void BM_Stream(benchmark::State& state, int width, int height) {
+  FlowSession session(g_model, {.threads = g_config.threads});
+  const auto frames = load_frames(width, height);
+  session.push(view(frames[0]));
+  session.push(view(frames[1]));  // warm-up
+  double total = 0;
+  std::size_t i = 2;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto f = session.push(view(frames[i % frames.size()]));
+    total += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    benchmark::DoNotOptimize(f);
+    ++i;
+  }
+  report(state, total / static_cast<double>(state.iterations()),
+         neuflow::model::network_cost(height, width).stream_frame());
+}
+
+// Our own options are taken out of argv before Google Benchmark sees the rest.
+bool take_option(int& argc, char** argv, const char* name, std::string& value) {
+  const std::size_t len = std::strlen(name);
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    int consumed = 0;
+    if (arg == name && i + 1 < argc) {
+      value = argv[i + 1];
+      consumed = 2;
+    } else if (arg.compare(0, len + 1, std::string(name) + "=") == 0) {
+      value = arg.substr(len + 1);
+      consumed = 1;
+    }
+    if (consumed) {
+      for (int j = i; j + consumed < argc; ++j) argv[j] = argv[j + consumed];
+      argc -= consumed;
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const char* shared_env = std::getenv("NEUFLOW_SHARED_DIR");
+  const std::filesystem::path shared = shared_env && *shared_env ? shared_env : NEUFLOW_DEFAULT_SHARED_DIR;
+  g_config.model = shared / "fixtures/neuflow-v2-seed0/checkpoint.pth";
+  g_config.frames = shared / "fixtures/frames";
+  std::string value;
+  if (take_option(argc, argv, "--model", value)) g_config.model = value;
+  if (take_option(argc, argv, "--frames", value)) g_config.frames = value;
+  if (take_option(argc, argv, "--threads", value)) g_config.threads = std::stoi(value);
+  if (take_option(argc, argv, "--sizes", value)) {
+    g_config.sizes.clear();
+    for (std::size_t pos = 0; pos < value.size();) {
+      const std::size_t comma = std::min(value.find(',', pos), value.size());
+      int w = 0, h = 0;
+      if (std::sscanf(value.substr(pos, comma - pos).c_str(), "%dx%d", &w, &h) != 2) {
+        std::fprintf(stderr, "neuflow-bench-core: --sizes wants WxH[,WxH...], got '%s'\n", value.c_str());
+        return 64;
+      }
+      g_config.sizes.emplace_back(w, h);
+      pos = comma + 1;
+    }
+  }
+  try {
+    g_model = FlowModel::load(g_config.model);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "neuflow-bench-core: %s\n(pass --model CKPT or set NEUFLOW_SHARED_DIR)\n", e.what());
+    return 66;
+  }
+
+  benchmark::RegisterBenchmark("sgemm_peak/2048", BM_SgemmPeak)->Arg(2048)->Iterations(8)->Unit(benchmark::kMillisecond);
+  for (const auto& [w, h] : g_config.sizes) {
+    const std::string size = std::to_string(w) + "x" + std::to_string(h);
+    benchmark::RegisterBenchmark(("pair/" + size).c_str(), BM_Pair, w, h)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+    benchmark::RegisterBenchmark(("stream/" + size).c_str(), BM_Stream, w, h)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 64;
+  std::printf("threads: %d, model: %s\n", g_config.threads, g_config.model.string().c_str());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,139 @@
+// Optimized kernels against naive versions written straight from the network doc.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "dnnl/context.hpp"
+#include "dnnl/conv_op.hpp"
+#include "ops/local_correlation.hpp"
+#include "tensor.hpp"
+
+namespace neuflow::model {
+namespace {
+
+void fill_random(std::vector<float>& v, std::mt19937& rng, float scale = 1.f) {
+  std::normal_distribution<float> d(0.f, scale);
+  for (float& x : v) x = d(rng);
+}
+
+// The reference's way: the all-pairs volume C[p, q] = <F0(p), F1(q)> / sqrt(C), sampled
+// bilinearly (corner-aligned, zero outside) at p + flow + (dx, dy).
+float naive_corr(const Tensor& f0, const Tensor& f1, const Tensor& flow, int y, int x, int dx, int dy) {
+  const auto volume = [&](int qy, int qx) -> double {
+    if (qx < 0 || qy < 0 || qx >= f1.w || qy >= f1.h) return 0.0;
+    double s = 0;
+    for (int c = 0; c < f0.c; ++c) s += static_cast<double>(f0.pixel(y, x)[c]) * f1.pixel(qy, qx)[c];
+    return s / std::sqrt(static_cast<double>(f0.c));
+  };
+  const double px = x + flow.pixel(y, x)[0] + dx, py = y + flow.pixel(y, x)[1] + dy;
+  const int x0 = static_cast<int>(std::floor(px)), y0 = static_cast<int>(std::floor(py));
+  const double ax = px - x0, ay = py - y0;
+  return static_cast<float>((1 - ax) * (1 - ay) * volume(y0, x0) + ax * (1 - ay) * volume(y0, x0 + 1) +
+                            (1 - ax) * ay * volume(y0 + 1, x0) + ax * ay * volume(y0 + 1, x0 + 1));
+}
+
+TEST(LocalCorrelation, MatchesSamplingTheAllPairsVolume) {
+  std::mt19937 rng(7);
+  const int h = 9, w = 13, c = 128;
+  Tensor f0(h, w, c), f1(h, w, c), flow(h, w, 2), out(h, w, 81 + 5);
+  fill_random(f0.data, rng);
+  fill_random(f1.data, rng);
+  fill_random(flow.data, rng, 3.f);  // fractional flows, many windows crossing the border
+  flow.pixel(0, 0)[0] = 1e9f;        // far outside: all zero
+  local_correlation(all_channels(f0), all_channels(f1), flow, out, 5);
+  double max_err = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int i = 0; i < 9; ++i) {
+        for (int j = 0; j < 9; ++j) {
+          const float expected = (y == 0 && x == 0) ? 0.f : naive_corr(f0, f1, flow, y, x, i - 4, j - 4);
+          const float got = out.pixel(y, x)[5 + i * 9 + j];
+          max_err = std::max(max_err, static_cast<double>(std::fabs(expected - got)));
+          ASSERT_NEAR(got, expected, 1e-4) << "pixel (" << x << ", " << y << ") dx " << i - 4 << " dy " << j - 4
+                                           << " flow (" << flow.pixel(y, x)[0] << ", " << flow.pixel(y, x)[1] << ")";
+        }
+      }
+    }
+  }
+  RecordProperty("max_err", std::to_string(max_err));
+}
+
+float naive_conv(const ConvWeights& w, const Tensor& in, int stride, int pad, int oy, int ox, int oc) {
+  double s = w.bias.empty() ? 0.0 : w.bias[oc];
+  for (int ic = 0; ic < w.in_channels; ++ic)
+    for (int ky = 0; ky < w.kernel_h; ++ky)
+      for (int kx = 0; kx < w.kernel_w; ++kx) {
+        const int iy = oy * stride - pad + ky, ix = ox * stride - pad + kx;
+        if (iy < 0 || ix < 0 || iy >= in.h || ix >= in.w) continue;
+        s += static_cast<double>(w.weight[((static_cast<std::size_t>(oc) * w.in_channels + ic) * w.kernel_h + ky) * w.kernel_w + kx]) *
+             in.pixel(iy, ix)[ic];
+      }
+  return static_cast<float>(s);
+}
+
+struct ConvCase {
+  int in_c, out_c, k, stride, pad, h, w;
+  bool bias;
+  Activation act;
+  bool accumulate;
+};
+
+class ConvOpTest : public ::testing::TestWithParam<ConvCase> {};
+
+TEST_P(ConvOpTest, MatchesNaiveConvolution) {
+  const ConvCase p = GetParam();
+  std::mt19937 rng(11);
+  ConvWeights w{p.out_c, p.in_c, p.k, p.k, std::vector<float>(static_cast<std::size_t>(p.out_c) * p.in_c * p.k * p.k), {}};
+  fill_random(w.weight, rng, 0.1f);
+  if (p.bias) {
+    w.bias.resize(p.out_c);
+    fill_random(w.bias, rng);
+  }
+  Tensor in(p.h, p.w, p.in_c), out, addend_t;
+  fill_random(in.data, rng);
+  dnnl::stream stream(cpu_engine());
+  ConvOp op(w, {p.stride, p.pad, p.act, p.accumulate}, nhwc_desc(p.h, p.w, p.in_c));
+  std::optional<dnnl::memory> addend;
+  if (p.accumulate) {
+    addend_t.resize(op.out_h(), op.out_w(), p.out_c);
+    fill_random(addend_t.data, rng);
+    addend = dnnl::memory(op.output_desc(), cpu_engine());
+    dnnl::memory src = wrap_nhwc(addend_t);
+    dnnl::reorder(src, *addend).execute(stream, src, *addend);
+  }
+  op.run_to_nhwc(stream, wrap_nhwc(in), out, addend ? &*addend : nullptr);
+  stream.wait();
+  ASSERT_EQ(out.h, (p.h + 2 * p.pad - p.k) / p.stride + 1);
+  for (int y = 0; y < out.h; ++y)
+    for (int x = 0; x < out.w; ++x)
+      for (int c = 0; c < p.out_c; ++c) {
+        float e = naive_conv(w, in, p.stride, p.pad, y, x, c);
+        if (p.accumulate) e += addend_t.pixel(y, x)[c];
+        switch (p.act) {
+          case Activation::none: break;
+          case Activation::relu: e = std::max(e, 0.f); break;
+          case Activation::leaky_relu: e = e < 0 ? 0.1f * e : e; break;
+          case Activation::gelu: e = 0.5f * e * (1.f + std::erf(e / std::sqrt(2.f))); break;
+        }
+        ASSERT_NEAR(out.pixel(y, x)[c], e, 1e-4f * (1.f + std::fabs(e)))
+            << "in_c " << p.in_c << " out_c " << p.out_c << " k " << p.k << " stride " << p.stride << " pad " << p.pad
+            << " at (" << x << ", " << y << ", " << c << ")";
+      }
+}
+
+// The shapes the network uses: the backbone's strided first convolutions on 3 channels,
+// channel counts that are not multiples of 8, fused activations and the accumulate path.
+INSTANTIATE_TEST_SUITE_P(NetworkShapes, ConvOpTest,
+                         ::testing::Values(ConvCase{3, 16, 8, 4, 2, 24, 32, false, Activation::leaky_relu, false},
+                                           ConvCase{3, 16, 6, 2, 2, 12, 16, false, Activation::leaky_relu, false},
+                                           ConvCase{3, 8, 8, 8, 0, 16, 24, false, Activation::leaky_relu, false},
+                                           ConvCase{147, 24, 3, 1, 1, 5, 7, false, Activation::leaky_relu, true},
+                                           ConvCase{96, 66, 3, 1, 1, 6, 5, true, Activation::none, false},
+                                           ConvCase{130, 32, 3, 1, 1, 4, 6, true, Activation::relu, false},
+                                           ConvCase{64, 40, 1, 1, 0, 4, 4, true, Activation::none, false},
+                                           ConvCase{40, 24, 3, 1, 1, 5, 5, false, Activation::gelu, false}));
+
+}  // namespace
+}  // namespace neuflow::model
