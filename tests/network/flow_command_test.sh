@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# `neuflow flow` on the fixture checkpoint and frames reproduces the reference's final flow,
+# in each output format, and fails with the documented exit codes on bad input.
+# Usage: flow_command_test.sh NEUFLOW_BINARY PYTHON_WITH_NUMPY
+set -u
+neuflow=$1
+python=$2
+fixture="${NEUFLOW_SHARED_DIR:-$(dirname "$0")/../../../shared}/fixtures/neuflow-v2-seed0"
+if [ ! -f "$fixture/checkpoint.pth" ]; then
+  echo "fixture not found: $fixture (set NEUFLOW_SHARED_DIR)"
+  if [ -n "${NEUFLOW_REQUIRE_FIXTURES:-}" ] && [ "${NEUFLOW_REQUIRE_FIXTURES}" != 0 ]; then exit 1; fi
+  exit 77
+fi
+if ! "$python" -c 'import numpy' 2>/dev/null; then
+  echo "$python cannot import numpy (install python3-numpy)"; exit 1
+fi
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+"$neuflow" flow --threads 2 -m "$fixture/checkpoint.pth" "$fixture/frame0.png" "$fixture/frame1.png" \
+  "$out/flow.npy" --viz "$out/viz.png" || fail "neuflow flow exited $?"
+[ -s "$out/viz.png" ] || fail "no visualization written"
+"$python" - "$out/flow.npy" "$fixture/flow.npy" <<'PY' || fail "flow differs from the reference"
+import sys, numpy as np
+ours = np.load(sys.argv[1])
+ref = np.load(sys.argv[2])[0].transpose(1, 2, 0)
+assert ours.shape == (256, 320, 2), ours.shape
+err = np.abs(ours - ref)
+print(f"max error {err.max():.2e} px, mean {err.mean():.2e} px")
+assert err.max() < 1e-2 and err.mean() < 1e-3
+PY
+
+"$neuflow" flow -m "$fixture/checkpoint.pth" "$fixture/frame0.png" "$fixture/frame1.png" "$out/flow.flo" --iters-s8 1 \
+  || fail ".flo output"
+"$neuflow" compare "$out/flow.flo" "$out/flow.flo" | grep -q "EPE" || fail "compare cannot read our .flo"
+
+"$neuflow" flow -m "$out/missing.pth" "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo"
+[ $? -eq 66 ] || fail "a missing checkpoint must exit 66"
+"$neuflow" flow -m "$fixture/frame0.png" "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo"
+[ $? -eq 65 ] || fail "a non-checkpoint must exit 65"
+"$neuflow" flow -m "$fixture/checkpoint.pth" "$fixture/manifest.json" "$fixture/frame1.png" "$out/x.flo"
+[ $? -eq 65 ] || fail "a non-image must exit 65"
+"$neuflow" flow -m "$fixture/checkpoint.pth" "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.txt"
+[ $? -ne 0 ] || fail "an unknown output extension must fail"
+"$neuflow" flow -m "$fixture/checkpoint.pth" "$fixture/frame0.png" "$fixture/frame1.png" "$out/no/such/dir/x.flo"
+[ $? -eq 73 ] || fail "an unwritable output must exit 73"
+echo "all flow command checks passed"
