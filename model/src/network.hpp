@@ -10,6 +10,7 @@
 #include "stages/global_matching.hpp"
 #include "stages/refinement.hpp"
 #include "stages/scale_merge.hpp"
+#include "dnnl/scratch_arena.hpp"
 #include "tensor.hpp"
 #include "weights.hpp"
 
@@ -32,6 +33,7 @@ class NetworkPlan {
 
  private:
   int height_, width_;
+  ScratchArena arena_;  // declared before the stages, which take buffers from it
   FrameEncoder encoder_;
   CrossAttention attention_;
   GlobalMatching matching_;

@@ -94,7 +94,9 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
   Tensor in(p.h, p.w, p.in_c), out, addend_t;
   fill_random(in.data, rng);
   dnnl::stream stream(cpu_engine());
-  ConvOp op(w, {p.stride, p.pad, p.act, p.accumulate}, nhwc_desc(p.h, p.w, p.in_c));
+  ScratchArena arena;
+  ConvOp op(w, {p.stride, p.pad, p.act, p.accumulate}, nhwc_desc(p.h, p.w, p.in_c), arena);
+  arena.finalize();
   std::optional<dnnl::memory> addend;
   if (p.accumulate) {
     addend_t.resize(op.out_h(), op.out_w(), p.out_c);

@@ -29,7 +29,7 @@ dnnl::primitive_attr make_attr(const ConvParams& p) {
 
 }  // namespace
 
-ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& input,
+ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& input, ScratchArena& arena,
                std::optional<memory::desc> output)
     : accumulate_(p.accumulate) {
   const auto& eng = cpu_engine();
@@ -68,9 +68,9 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
   }
   s.wait();
 
-  dst_ = memory(pd.dst_desc(), eng);
+  dst_ = arena.make(pd.dst_desc());
   if (pd.src_desc() != input) {
-    reordered_input_ = memory(pd.src_desc(), eng);
+    reordered_input_ = arena.make(pd.src_desc());
     input_reorder_ = dnnl::reorder(dnnl::reorder::primitive_desc(eng, input, eng, pd.src_desc()));
   }
 }

@@ -5,6 +5,7 @@
 
 #include <optional>
 
+#include "dnnl/scratch_arena.hpp"
 #include "tensor.hpp"
 #include "weights.hpp"
 
@@ -24,9 +25,10 @@ struct ConvParams {
 class ConvOp {
  public:
   // `input` describes the memory run() will receive: NHWC from a stage, or a previous
-  // ConvOp's output(). `output` forces the output layout (default: the primitive's choice).
+  // ConvOp's output(). The output and any reordered input live in `arena` (current region).
+  // `output` forces the output layout (default: the primitive's choice).
   ConvOp(const ConvWeights& weights, const ConvParams& params, const dnnl::memory::desc& input,
-         std::optional<dnnl::memory::desc> output = std::nullopt);
+         ScratchArena& arena, std::optional<dnnl::memory::desc> output = std::nullopt);
 
   // Runs the convolution; `addend` (required iff params.accumulate) must have output_desc().
   const dnnl::memory& run(dnnl::stream& stream, const dnnl::memory& input,

@@ -13,13 +13,13 @@ namespace neuflow::model {
 
 class ConvexUpsampler {
  public:
-  ConvexUpsampler(const NetworkWeights& weights, int h8, int w8);
+  ConvexUpsampler(const NetworkWeights& weights, int h8, int w8, ScratchArena& arena);
 
   // flow8 [h8, w8, 2], image_features [h8, w8, 128] (conv_s8 of frame 0) → flow [8·h8, 8·w8, 2].
   void run(dnnl::stream& stream, const Tensor& flow8, const Tensor& image_features, Tensor& flow);
 
  private:
-  Tensor input_, mask_;
+  Tensor input_;
   std::optional<ConvOp> conv1_, conv2_, conv3_;
 };
 

@@ -9,8 +9,8 @@ namespace neuflow::model {
 
 namespace {
 constexpr int kDim = 192;
-// Query rows per attention block: bounds the score block to ~4M floats at any resolution.
-constexpr int kScoreBlockFloats = 1 << 22;
+// Query rows per attention block: bounds the score block to 1M floats (4 MB) at any resolution.
+constexpr int kScoreBlockFloats = 1 << 20;
 
 MatrixView rows(const float* data, int n, int cols, int ld) { return {data, n, cols, ld}; }
 }  // namespace

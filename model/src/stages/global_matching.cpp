@@ -8,7 +8,7 @@
 namespace neuflow::model {
 
 namespace {
-constexpr int kScoreBlockFloats = 1 << 22;
+constexpr int kScoreBlockFloats = 1 << 20;
 
 void gather(const ChannelSlice& f, std::vector<float>& out) {
   const int c = f.channels;
