@@ -19,6 +19,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -140,6 +141,40 @@ void BM_Stream(benchmark::State& state, int width, int height) {
          neuflow::model::network_cost(height, width).stream_frame());
 }
 
+// Where a streamed frame's time goes: the observer is called at the end of each stage, so the
+// time between consecutive calls is the stage's (refinement iterations summed per scale).
+void BM_StreamStages(benchmark::State& state, int width, int height) {
+  FlowSession session(g_model, {.threads = g_config.threads});
+  const auto frames = load_frames(width, height);
+  std::map<std::string, double> stage_seconds;
+  auto last = std::chrono::steady_clock::now();
+  const auto group = [](const std::string& name) -> std::string {
+    if (name.rfind("refine_s8", 0) == 0 || name.rfind("corr_s8", 0) == 0) return "refine_s8";
+    if (name.rfind("refine_s16", 0) == 0 || name.rfind("corr_s16", 0) == 0) return "refine_s16";
+    if (name == "backbone_s16" || name == "backbone_s8" || name == "conv_s8") return "encode";
+    if (name == "merge_s8" || name == "context_merge_s8") return "merge_s8";
+    if (name == "flow") return "upsample";
+    return name;
+  };
+  session.set_observer([&](const neuflow::model::StageTensor& t) {
+    const auto now = std::chrono::steady_clock::now();
+    stage_seconds[group(t.name)] += std::chrono::duration<double>(now - last).count();
+    last = now;
+  });
+  session.push(view(frames[0]));
+  std::size_t i = 1;
+  for (auto _ : state) {
+    last = std::chrono::steady_clock::now();
+    auto f = session.push(view(frames[i % frames.size()]));
+    stage_seconds["restore"] += std::chrono::duration<double>(std::chrono::steady_clock::now() - last).count();
+    benchmark::DoNotOptimize(f);
+    ++i;
+  }
+  for (const auto& [name, seconds] : stage_seconds) {
+    state.counters[name + "_ms"] = seconds * 1e3 / static_cast<double>(state.iterations());
+  }
+}
+
 // Our own options are taken out of argv before Google Benchmark sees the rest.
 bool take_option(int& argc, char** argv, const char* name, std::string& value) {
   const std::size_t len = std::strlen(name);
@@ -198,6 +233,9 @@ int main(int argc, char** argv) {
     const std::string size = std::to_string(w) + "x" + std::to_string(h);
     benchmark::RegisterBenchmark(("pair/" + size).c_str(), BM_Pair, w, h)->Unit(benchmark::kMillisecond)->MinTime(2.0);
     benchmark::RegisterBenchmark(("stream/" + size).c_str(), BM_Stream, w, h)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+    benchmark::RegisterBenchmark(("stream_stages/" + size).c_str(), BM_StreamStages, w, h)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(3);
   }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 64;

@@ -27,5 +27,6 @@ struct CommandError : std::runtime_error {
 void register_viz(CLI::App& app);
 void register_compare(CLI::App& app);
 void register_inspect(CLI::App& app);
+void register_flow(CLI::App& app);
 
 }  // namespace neuflow::cli

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   neuflow::cli::register_viz(app);
   neuflow::cli::register_compare(app);
   neuflow::cli::register_inspect(app);
+  neuflow::cli::register_flow(app);
 
   try {
     app.parse(argc, argv);
