@@ -1,0 +1,63 @@
+#include "neuflow/flow/metrics.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "field_check.hpp"
+
+namespace neuflow::flow {
+
+FlowMetrics compute_metrics(const FlowField& predicted, const FlowField& ground_truth,
+                            const MetricsOptions& options) {
+  detail::check_field(predicted, "compute_metrics (prediction)");
+  detail::check_field(ground_truth, "compute_metrics (ground truth)");
+  if (predicted.width != ground_truth.width || predicted.height != ground_truth.height) {
+    throw std::invalid_argument("compute_metrics: prediction is " +
+                                std::to_string(predicted.width) + "x" +
+                                std::to_string(predicted.height) + " but ground truth is " +
+                                std::to_string(ground_truth.width) + "x" +
+                                std::to_string(ground_truth.height));
+  }
+
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  FlowMetrics m;
+  m.total_pixels = ground_truth.pixel_count();
+  double sum_error = 0;
+  std::size_t outliers = 0, within1 = 0, within3 = 0, within5 = 0;
+  for (std::size_t i = 0; i < m.total_pixels; ++i) {
+    if (!ground_truth.valid.empty() && ground_truth.valid[i] == 0) continue;
+    if (options.use_predicted_mask && !predicted.valid.empty() && predicted.valid[i] == 0) continue;
+    const double gu = ground_truth.uv[2 * i];
+    const double gv = ground_truth.uv[2 * i + 1];
+    if (!std::isfinite(gu) || !std::isfinite(gv)) continue;
+    const double du = predicted.uv[2 * i] - gu;
+    const double dv = predicted.uv[2 * i + 1] - gv;
+    double error = std::sqrt(du * du + dv * dv);
+    if (!std::isfinite(error)) error = kInf;
+    const double gt_magnitude = std::sqrt(gu * gu + gv * gv);
+    ++m.valid_pixels;
+    sum_error += error;
+    // The KITTI devkit's test is err > 3 && err / |gt| > 0.05; multiplying avoids the 0/0.
+    if (error > 3.0 && error > 0.05 * gt_magnitude) ++outliers;
+    if (error < 1.0) ++within1;
+    if (error < 3.0) ++within3;
+    if (error < 5.0) ++within5;
+  }
+
+  if (m.valid_pixels == 0) {
+    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+    m.epe = m.fl_all = m.within_1px = m.within_3px = m.within_5px = kNaN;
+    return m;
+  }
+  const auto n = static_cast<double>(m.valid_pixels);
+  m.epe = sum_error / n;
+  m.fl_all = static_cast<double>(outliers) / n;
+  m.within_1px = static_cast<double>(within1) / n;
+  m.within_3px = static_cast<double>(within3) / n;
+  m.within_5px = static_cast<double>(within5) / n;
+  return m;
+}
+
+}  // namespace neuflow::flow
