@@ -1,6 +1,10 @@
 #include "ops/local_correlation.hpp"
 
 #include <cmath>
+
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
 #include <stdexcept>
 
 namespace neuflow::model {
@@ -8,16 +12,46 @@ namespace neuflow::model {
 namespace {
 
 float dot(const float* a, const float* b, int n) {
-  float acc[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  int i = 0;
-  for (; i + 8 <= n; i += 8) {
-    for (int k = 0; k < 8; ++k) acc[k] += a[i + k] * b[i + k];
-  }
   float s = 0.f;
-  for (; i < n; ++i) s += a[i] * b[i];
-  for (float v : acc) s += v;
+#pragma omp simd reduction(+ : s)
+  for (int i = 0; i < n; ++i) s += a[i] * b[i];
   return s;
 }
+
+#if defined(__AVX2__) && defined(__FMA__)
+float horizontal_sum(__m256 v) {
+  __m128 x = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  x = _mm_add_ps(x, _mm_movehl_ps(x, x));
+  x = _mm_add_ss(x, _mm_movehdup_ps(x));
+  return _mm_cvtss_f32(x);
+}
+
+// Dot products of `a` with five consecutive pixels b, b + stride, ...: each chunk of `a` is
+// loaded once for five FMAs. n must be a multiple of 8.
+void dot5(const float* a, const float* b, int stride, int n, float* out) {
+  __m256 acc0 = _mm256_setzero_ps(), acc1 = _mm256_setzero_ps(), acc2 = _mm256_setzero_ps();
+  __m256 acc3 = _mm256_setzero_ps(), acc4 = _mm256_setzero_ps();
+  for (int i = 0; i < n; i += 8) {
+    const __m256 va = _mm256_loadu_ps(a + i);
+    acc0 = _mm256_fmadd_ps(va, _mm256_loadu_ps(b + i), acc0);
+    acc1 = _mm256_fmadd_ps(va, _mm256_loadu_ps(b + stride + i), acc1);
+    acc2 = _mm256_fmadd_ps(va, _mm256_loadu_ps(b + 2 * stride + i), acc2);
+    acc3 = _mm256_fmadd_ps(va, _mm256_loadu_ps(b + 3 * stride + i), acc3);
+    acc4 = _mm256_fmadd_ps(va, _mm256_loadu_ps(b + 4 * stride + i), acc4);
+  }
+  out[0] = horizontal_sum(acc0);
+  out[1] = horizontal_sum(acc1);
+  out[2] = horizontal_sum(acc2);
+  out[3] = horizontal_sum(acc3);
+  out[4] = horizontal_sum(acc4);
+}
+constexpr bool kHaveDot5 = true;
+#else
+void dot5(const float* a, const float* b, int stride, int n, float* out) {
+  for (int k = 0; k < 5; ++k) out[k] = dot(a, b + k * stride, n);
+}
+constexpr bool kHaveDot5 = false;
+#endif
 
 }  // namespace
 
@@ -29,7 +63,7 @@ void local_correlation(const ChannelSlice& f0, const ChannelSlice& f1, const Ten
     throw std::logic_error("local_correlation: shapes do not fit");
   }
   const float norm = 1.f / std::sqrt(static_cast<float>(channels));
-  constexpr int n = kCorrWindow + 1;  // integer neighbours per axis
+  constexpr int n = kCorrWindow + 1;  // integer neighbours per axis, two groups of five
 
 #pragma omp parallel for
   for (int y = 0; y < h; ++y) {
@@ -48,11 +82,25 @@ void local_correlation(const ChannelSlice& f0, const ChannelSlice& f1, const Ten
       }
       const int bx = static_cast<int>(fx0) - kCorrRadius, by = static_cast<int>(fy0) - kCorrRadius;
       const float* a = f0.pixel(y, x);
-      for (int i = 0; i < n; ++i) {
-        const int qx = bx + i;
-        for (int j = 0; j < n; ++j) {
-          const int qy = by + j;
-          d[i][j] = (qx >= 0 && qx < w && qy >= 0 && qy < h) ? dot(a, f1.pixel(qy, qx), channels) * norm : 0.f;
+      // Row by row of frame 1: the ten neighbours of a row are consecutive pixels in memory.
+      for (int j = 0; j < n; ++j) {
+        const int qy = by + j;
+        if (qy < 0 || qy >= h) {
+          for (int i = 0; i < n; ++i) d[i][j] = 0.f;
+          continue;
+        }
+        int i = 0;
+        for (; i < n; i += 5) {
+          float five[5];
+          if (kHaveDot5 && channels % 8 == 0 && bx + i >= 0 && bx + i + 5 <= w) {
+            dot5(a, f1.pixel(qy, bx + i), f1.stride(), channels, five);
+          } else {  // at the frame's border
+            for (int k = 0; k < 5; ++k) {
+              const int qx = bx + i + k;
+              five[k] = (qx >= 0 && qx < w) ? dot(a, f1.pixel(qy, qx), channels) : 0.f;
+            }
+          }
+          for (int k = 0; k < 5; ++k) d[i + k][j] = five[k] * norm;
         }
       }
       const float w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay, w11 = ax * ay;
