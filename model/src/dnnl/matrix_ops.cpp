@@ -38,13 +38,28 @@ void matmul(dnnl::stream& stream, MatrixView a, MatrixView b, float* c, int ldc,
   dnnl::matmul(pd).execute(stream, args);
 }
 
-void softmax_rows(dnnl::stream& stream, float* data, int rows, int cols) {
+namespace {
+
+void softmax(dnnl::stream& stream, float* data, int rows, int cols, int axis) {
   const auto& eng = cpu_engine();
   const memory::desc md({rows, cols}, dt::f32, memory::format_tag::ab);
   const dnnl::softmax_forward::primitive_desc pd(
-      dnnl::softmax_forward::desc(dnnl::prop_kind::forward_inference, md, 1), eng);
+      dnnl::softmax_forward::desc(dnnl::prop_kind::forward_inference, md, axis), eng);
   memory mem(md, eng, data);
   dnnl::softmax_forward(pd).execute(stream, {{DNNL_ARG_SRC, mem}, {DNNL_ARG_DST, mem}});
+}
+
+}  // namespace
+
+void softmax_rows(dnnl::stream& stream, float* data, int rows, int cols) { softmax(stream, data, rows, cols, 1); }
+
+void exp_in_place(dnnl::stream& stream, float* data, std::size_t count) {
+  const auto& eng = cpu_engine();
+  const memory::desc md({static_cast<memory::dim>(count)}, dt::f32, memory::format_tag::a);
+  const dnnl::eltwise_forward::primitive_desc pd(
+      dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_exp, md), eng);
+  memory mem(md, eng, data);
+  dnnl::eltwise_forward(pd).execute(stream, {{DNNL_ARG_SRC, mem}, {DNNL_ARG_DST, mem}});
 }
 
 }  // namespace neuflow::model

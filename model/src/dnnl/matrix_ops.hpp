@@ -3,6 +3,8 @@
 // oneDNN's primitive cache on each call, so repeated shapes cost no re-creation.
 #include <dnnl.hpp>
 
+#include <cstddef>
+
 namespace neuflow::model {
 
 struct MatrixView {
@@ -25,5 +27,8 @@ void matmul(dnnl::stream& stream, MatrixView a, MatrixView b, float* c, int ldc,
 
 // In place: every row of the [rows, cols] contiguous matrix becomes its softmax.
 void softmax_rows(dnnl::stream& stream, float* data, int rows, int cols);
+
+// In place: x = exp(x) over `count` contiguous values.
+void exp_in_place(dnnl::stream& stream, float* data, std::size_t count);
 
 }  // namespace neuflow::model

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "dnnl/context.hpp"
+#include "dnnl/matrix_ops.hpp"
 #include "ops/feature_ops.hpp"
 
 namespace neuflow::model {
@@ -29,9 +30,28 @@ void ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tenso
   copy_channels(all_channels(image_features), input_, 2);
   const auto& mask_memory = conv3_->run(stream, conv2_->run(stream, conv1_->run(stream, wrap_nhwc(input_))));
   stream.wait();
-  const auto* mask = static_cast<const float*>(mask_memory.get_data_handle());
-
+  // In 8-channel blocks the mask is a row-major [9, 64 · h8 · w8] matrix: row k holds the
+  // weight logits of neighbour k for every output pixel, contiguous in the output's x within
+  // a coarse pixel. The softmax over the 9 neighbours runs in three vectorizable passes:
+  // subtract each column's max, exp (oneDNN's jitted eltwise), then normalized weighted sums.
   const int h8 = flow8.h, w8 = flow8.w;
+  const std::size_t plane = static_cast<std::size_t>(h8) * w8 * kFactor * kFactor;
+  auto* mask = static_cast<float*>(mask_memory.get_data_handle());
+  const long columns = static_cast<long>(plane);
+#pragma omp parallel for
+  for (long block = 0; block < columns; block += kFactor) {
+    float mx[kFactor];
+    for (int b = 0; b < kFactor; ++b) mx[b] = mask[block + b];
+    for (int k = 1; k < kNeighbours; ++k) {
+      for (int b = 0; b < kFactor; ++b) mx[b] = std::max(mx[b], mask[k * plane + block + b]);
+    }
+    for (int k = 0; k < kNeighbours; ++k) {
+      for (int b = 0; b < kFactor; ++b) mask[k * plane + block + b] -= mx[b];
+    }
+  }
+  exp_in_place(stream, mask, kNeighbours * plane);
+  stream.wait();
+
   flow.resize(h8 * kFactor, w8 * kFactor, 2);
 #pragma omp parallel for
   for (int y = 0; y < h8; ++y) {
@@ -44,24 +64,22 @@ void ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tenso
         nu[k] = inside ? flow8.pixel(yy, xx)[0] : 0.f;
         nv[k] = inside ? flow8.pixel(yy, xx)[1] : 0.f;
       }
-      // mask value (k, a, b) at this pixel: block (k * 8 + a), lane b.
-      const std::size_t pixel = static_cast<std::size_t>(y) * w8 + x;
-      const std::size_t plane = static_cast<std::size_t>(h8) * w8 * kFactor;
-      const auto m = [&](int k, int a, int b) { return mask[(k * kFactor + a) * plane + pixel * kFactor + b]; };
+      // Weight of neighbour k for output (8y + a, 8x + b): block (k * 8 + a), lane b.
+      const std::size_t pixel = (static_cast<std::size_t>(y) * w8 + x) * kFactor;
       for (int a = 0; a < kFactor; ++a) {
-        for (int b = 0; b < kFactor; ++b) {
-          float mx = m(0, a, b);
-          for (int k = 1; k < kNeighbours; ++k) mx = std::max(mx, m(k, a, b));
-          float sum = 0.f, u = 0.f, v = 0.f;
-          for (int k = 0; k < kNeighbours; ++k) {
-            const float e = std::exp(m(k, a, b) - mx);
-            sum += e;
-            u += e * nu[k];
-            v += e * nv[k];
+        float sum[kFactor] = {}, u[kFactor] = {}, v[kFactor] = {};
+        for (int k = 0; k < kNeighbours; ++k) {
+          const float* e = mask + static_cast<std::size_t>(k) * plane + a * (plane / kFactor) + pixel;
+          for (int b = 0; b < kFactor; ++b) {
+            sum[b] += e[b];
+            u[b] += e[b] * nu[k];
+            v[b] += e[b] * nv[k];
           }
-          float* out = flow.pixel(y * kFactor + a, x * kFactor + b);
-          out[0] = kFactor * u / sum;
-          out[1] = kFactor * v / sum;
+        }
+        float* out = flow.pixel(y * kFactor + a, x * kFactor);
+        for (int b = 0; b < kFactor; ++b) {
+          out[2 * b] = kFactor * u[b] / sum[b];
+          out[2 * b + 1] = kFactor * v[b] / sum[b];
         }
       }
     }
