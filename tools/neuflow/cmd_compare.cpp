@@ -20,16 +20,6 @@ struct CompareOptions {
   bool use_predicted_mask = false;
 };
 
-int exit_code_for(const flow::FlowFileError& e) {
-  switch (e.kind()) {
-    case flow::FlowFileError::Kind::not_found: return kExitNoInput;
-    case flow::FlowFileError::Kind::write_failed: return kExitCantCreate;
-    case flow::FlowFileError::Kind::malformed:
-    case flow::FlowFileError::Kind::unsupported_format: return kExitDataError;
-  }
-  return kExitFailure;
-}
-
 flow::FlowField read(const std::string& path) {
   try {
     return flow::read_flow(path);

@@ -39,7 +39,7 @@ std::shared_ptr<const model::FlowModel> load_model(const std::string& path) {
   try {
     return model::FlowModel::load(path);
   } catch (const model::CheckpointError& e) {
-    throw CommandError(e.kind() == model::CheckpointError::Kind::kIo ? kExitNoInput : kExitDataError, e.what());
+    throw CommandError(exit_code_for(e), e.what());
   }
 }
 
@@ -82,7 +82,7 @@ void run_flow(const FlowArgs& a) {
       flow::write_rgb_png(flow::visualize_flow(field, vo).image, a.viz);
     }
   } catch (const flow::FlowFileError& e) {
-    throw CommandError(kExitCantCreate, e.what());
+    throw CommandError(exit_code_for(e), e.what());
   }
   std::fprintf(stderr, "%s: %dx%d flow in %.2f s, max |flow| %.2f px\n", a.output.c_str(), field.width, field.height,
                seconds, flow::max_flow_magnitude(field));

@@ -38,9 +38,7 @@ void run_inspect(const std::string& path, bool list) {
   try {
     checkpoint = model::load_checkpoint(path);
   } catch (const model::CheckpointError& e) {
-    const int code =
-        e.kind() == model::CheckpointError::Kind::kIo ? kExitNoInput : kExitDataError;
-    throw CommandError(code, std::string("inspect: ") + e.what());
+    throw CommandError(exit_code_for(e), std::string("inspect: ") + e.what());
   }
 
   std::map<std::string, int> dtypes;

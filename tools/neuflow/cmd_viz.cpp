@@ -23,16 +23,6 @@ struct VizOptions {
   bool fixed_max = false;
 };
 
-int exit_code_for(const flow::FlowFileError& e) {
-  switch (e.kind()) {
-    case flow::FlowFileError::Kind::not_found: return kExitNoInput;
-    case flow::FlowFileError::Kind::write_failed: return kExitCantCreate;
-    case flow::FlowFileError::Kind::malformed:
-    case flow::FlowFileError::Kind::unsupported_format: return kExitDataError;
-  }
-  return kExitFailure;
-}
-
 std::string require_png_name(const std::string& name) {
   std::string ext = name.size() >= 4 ? name.substr(name.size() - 4) : std::string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));

@@ -6,6 +6,13 @@
 #include <stdexcept>
 #include <string>
 
+namespace neuflow::flow {
+class FlowFileError;
+}
+namespace neuflow::model {
+class CheckpointError;
+}
+
 namespace neuflow::cli {
 
 // Exit codes (sysexits.h) for the classes a script may want to tell apart; bad usage is
@@ -22,6 +29,10 @@ struct CommandError : std::runtime_error {
   CommandError(int code, const std::string& message) : std::runtime_error(message), exit_code(code) {}
   int exit_code;
 };
+
+// The exit code for a failure to read or write a flow file, or to load a checkpoint.
+int exit_code_for(const flow::FlowFileError& e);
+int exit_code_for(const model::CheckpointError& e);
 
 // Registration functions, one per cmd_*.cpp.
 void register_viz(CLI::App& app);
