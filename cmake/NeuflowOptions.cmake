@@ -3,7 +3,10 @@ add_library(neuflow_options INTERFACE)
 add_library(neuflow::options ALIAS neuflow_options)
 
 target_compile_options(neuflow_options INTERFACE
-  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wold-style-cast -Wcast-align
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align
+  # GLib/GStreamer type macros (G_DEFINE_TYPE, GST_*_CAST) expand to C casts: targets built on
+  # them set the property NEUFLOW_GLIB_MACROS.
+  $<$<NOT:$<BOOL:$<TARGET_PROPERTY:NEUFLOW_GLIB_MACROS>>>:-Wold-style-cast>
   -Woverloaded-virtual -Wformat=2 -Wimplicit-fallthrough
   # GCC 12 reports -Wrestrict inside libstdc++'s own std::string code at -O3 (GCC bug 105329).
   -Wno-restrict

@@ -9,6 +9,8 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-video-dev
   libzip-dev                        # the zip container of PyTorch checkpoints
   libcli11-dev                      # command-line parsing
+  libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer plugin
+  gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy             # tests check that numpy reads our .npy files
 )

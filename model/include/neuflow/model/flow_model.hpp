@@ -15,6 +15,10 @@ class FlowModel {
   // Throws CheckpointError (see checkpoint.hpp) naming the file and the problem.
   static std::shared_ptr<const FlowModel> load(const std::filesystem::path& checkpoint);
 
+  // The same, but one instance per checkpoint file in the process: while any user holds the
+  // model, loading the same file again returns it instead of a second copy.
+  static std::shared_ptr<const FlowModel> load_shared(const std::filesystem::path& checkpoint);
+
   ~FlowModel();
   FlowModel(const FlowModel&) = delete;
   FlowModel& operator=(const FlowModel&) = delete;

@@ -1,0 +1,839 @@
+/**
+ * SECTION:element-neuflow
+ *
+ * Computes NeuFlow-V2 optical flow between consecutive video frames and attaches it to each
+ * frame as a NeuflowFlowMeta (see neuflow/gst/flow_meta.h): the flow from the previous
+ * processed frame to this one. Video passes through unchanged in any size and common raw
+ * format; the element converts and pads or resizes internally.
+ *
+ * Inference runs on the element's own thread. In live mode (the default for live sources)
+ * the streaming thread never waits for it: a frame arriving while the previous one is still
+ * queued replaces it (newest wins), the replaced frame is dropped and announced with a QoS
+ * message, and the latency is reported in the LATENCY query. In every-pair mode (the
+ * default for non-live sources) every frame is processed, upstream waits when two frames are
+ * queued, and nothing is dropped. The first frame of a stream (and the first after a flush
+ * or a size change) leaves without flow.
+ *
+ * ## Example launch lines
+ * |[
+ * gst-launch-1.0 v4l2src ! videoconvert ! neuflow model=neuflow_mixed.pth ! neuflowviz ! videoconvert ! autovideosink
+ * gst-launch-1.0 filesrc location=in.mp4 ! decodebin ! videoconvert ! neuflow model=neuflow_mixed.pth ! neuflowsink location=flow_%05d.flo
+ * ]|
+ */
+#include <gst/gst.h>
+#include <gst/video/video.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "elements.hpp"
+#include "neuflow/gst/flow_meta.h"
+#include "neuflow/model/checkpoint.hpp"
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/flow_session.hpp"
+
+GST_DEBUG_CATEGORY_STATIC(gst_neuflow_debug);
+#define GST_CAT_DEFAULT gst_neuflow_debug
+
+namespace {
+
+using neuflow::model::ChannelOrder;
+using neuflow::model::FlowModel;
+using neuflow::model::FlowSession;
+
+enum class Behaviour { automatic, live, every_pair };
+
+enum {
+  PROP_0,
+  PROP_MODEL,
+  PROP_ITERS_S16,
+  PROP_ITERS_S8,
+  PROP_MODEL_WIDTH,
+  PROP_MODEL_HEIGHT,
+  PROP_THREADS,
+  PROP_CHANNEL_ORDER,
+  PROP_BEHAVIOUR,
+  PROP_STATS_INTERVAL,
+  PROP_FRAMES_IN,
+  PROP_FRAMES_PROCESSED,
+  PROP_FRAMES_DROPPED,
+  PROP_MEAN_LATENCY,
+  PROP_PROCESSING_RATE,
+};
+
+constexpr guint DEFAULT_ITERS_S16 = 1;
+constexpr guint DEFAULT_ITERS_S8 = 8;
+constexpr guint DEFAULT_MODEL_SIZE = 0;
+constexpr guint DEFAULT_THREADS = 0;
+constexpr guint DEFAULT_STATS_INTERVAL = 1000;  // ms; 0 = no stats messages
+constexpr std::size_t kEveryPairQueuedBuffers = 2;
+
+struct Settings {
+  std::string model;
+  guint iters_s16 = DEFAULT_ITERS_S16;
+  guint iters_s8 = DEFAULT_ITERS_S8;
+  guint model_width = DEFAULT_MODEL_SIZE;
+  guint model_height = DEFAULT_MODEL_SIZE;
+  guint threads = DEFAULT_THREADS;
+  ChannelOrder order = ChannelOrder::rgb;
+  Behaviour behaviour = Behaviour::automatic;
+  guint stats_interval = DEFAULT_STATS_INTERVAL;
+};
+
+// One entry of the ordered stream between the streaming thread and the worker.
+struct Item {
+  GstBuffer *buffer = nullptr;  // either a frame...
+  GstEvent *event = nullptr;    // ...or a serialized event
+  guint64 frame = 0;            // frame number (all frames in, dropped ones included)
+};
+
+void release(Item &item) {
+  if (item.buffer) gst_buffer_unref(item.buffer);
+  if (item.event) gst_event_unref(item.event);
+  item = {};
+}
+
+struct Stats {
+  guint64 frames_in = 0;
+  guint64 processed = 0;  // frames that left, with or without flow
+  guint64 flows = 0;      // frames that left with flow
+  guint64 dropped = 0;
+  double inference_seconds = 0;  // sum over flows
+  double last_inference_seconds = 0;
+  std::chrono::steady_clock::time_point started{};
+  std::chrono::steady_clock::time_point last_message{};
+};
+
+// Everything the worker and the streaming thread share lives under `lock`.
+struct State {
+  std::mutex lock;
+  std::condition_variable cond;
+  std::deque<Item> queue;
+  bool flushing = true;
+  bool busy = false;                 // the worker holds an item
+  GstFlowReturn downstream = GST_FLOW_OK;  // the worker's last push result, returned upstream
+  std::optional<bool> live;          // resolved from the behaviour and upstream's liveness
+  GstSegment segment{};
+  Stats stats;
+  guint64 next_frame = 0;
+
+  // Worker-only state (no lock needed: only the worker thread touches it while running).
+  std::unique_ptr<FlowSession> session;
+  GstVideoInfo info{};
+  bool have_info = false;
+  GstVideoConverter *converter = nullptr;
+  std::vector<guint8> rgb;
+  GstClockTime previous_pts = GST_CLOCK_TIME_NONE;
+  guint64 previous_frame = 0;
+};
+
+}  // namespace
+
+struct GstNeuflow {
+  GstElement parent;
+  GstPad *sinkpad;
+  GstPad *srcpad;
+  Settings *settings;  // under the object lock
+  std::shared_ptr<const FlowModel> *model;
+  State *state;
+};
+
+struct GstNeuflowClass {
+  GstElementClass parent_class;
+};
+
+G_DEFINE_TYPE(GstNeuflow, gst_neuflow, GST_TYPE_ELEMENT)
+
+#define GST_NEUFLOW(obj) (reinterpret_cast<GstNeuflow *>(obj))
+
+namespace {
+
+#define NEUFLOW_VIDEO_CAPS \
+  GST_VIDEO_CAPS_MAKE("{ RGB, BGR, RGBx, BGRx, xRGB, xBGR, RGBA, BGRA, GRAY8, I420, NV12, YUY2 }")
+
+GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(NEUFLOW_VIDEO_CAPS));
+GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(NEUFLOW_VIDEO_CAPS));
+
+GType channel_order_get_type() {
+  static GType type = 0;
+  static const GEnumValue values[] = {
+      {static_cast<gint>(ChannelOrder::rgb), "RGB, the order the published weights were trained with", "rgb"},
+      {static_cast<gint>(ChannelOrder::bgr), "BGR, as the reference demo scripts feed it", "bgr"},
+      {0, nullptr, nullptr}};
+  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstNeuflowChannelOrder", values));
+  return type;
+}
+
+GType behaviour_get_type() {
+  static GType type = 0;
+  static const GEnumValue values[] = {
+      {static_cast<gint>(Behaviour::automatic), "live for live sources, every-pair otherwise", "auto"},
+      {static_cast<gint>(Behaviour::live), "hold real-time: newest frame wins, late frames dropped", "live"},
+      {static_cast<gint>(Behaviour::every_pair), "every consecutive pair, upstream waits, nothing dropped",
+       "every-pair"},
+      {0, nullptr, nullptr}};
+  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstNeuflowBehaviour", values));
+  return type;
+}
+
+Settings copy_settings(GstNeuflow *self) {
+  GST_OBJECT_LOCK(self);
+  Settings s = *self->settings;
+  GST_OBJECT_UNLOCK(self);
+  return s;
+}
+
+void clear_queue(State &st) {
+  for (auto &item : st.queue) release(item);
+  st.queue.clear();
+}
+
+// ---- worker side ---------------------------------------------------------------------------
+
+void post_stats(GstNeuflow *self, const Stats &s) {
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.started).count();
+  GstStructure *st = gst_structure_new(
+      "neuflow-stats", "frames-in", G_TYPE_UINT64, s.frames_in, "frames-processed", G_TYPE_UINT64, s.processed,
+      "frames-dropped", G_TYPE_UINT64, s.dropped, "mean-latency", G_TYPE_DOUBLE,
+      s.flows ? 1e3 * s.inference_seconds / static_cast<double>(s.flows) : 0.0, "processing-rate", G_TYPE_DOUBLE,
+      elapsed > 0 ? static_cast<double>(s.processed) / elapsed : 0.0, nullptr);
+  gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), st));
+}
+
+// Gives the frame to the session as RGB (or BGR when asked), converting other formats.
+neuflow::model::ImageView frame_view(State &st, GstVideoFrame &frame, ChannelOrder order) {
+  const GstVideoFormat format = GST_VIDEO_INFO_FORMAT(&st.info);
+  const int width = GST_VIDEO_INFO_WIDTH(&st.info), height = GST_VIDEO_INFO_HEIGHT(&st.info);
+  // BGR data claimed as BGR is swapped by the session; claiming the other order skips the
+  // swap, which is how the network is fed BGR on request.
+  const auto claim = [&](ChannelOrder data_order) {
+    return order == ChannelOrder::rgb ? data_order
+                                      : (data_order == ChannelOrder::rgb ? ChannelOrder::bgr : ChannelOrder::rgb);
+  };
+  if (format == GST_VIDEO_FORMAT_RGB || format == GST_VIDEO_FORMAT_BGR) {
+    return {static_cast<const std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 0)), width, height,
+            GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 0),
+            claim(format == GST_VIDEO_FORMAT_RGB ? ChannelOrder::rgb : ChannelOrder::bgr)};
+  }
+  GstVideoFrame out;
+  GstVideoInfo rgb_info;
+  gst_video_info_set_format(&rgb_info, GST_VIDEO_FORMAT_RGB, width, height);
+  st.rgb.resize(GST_VIDEO_INFO_SIZE(&rgb_info));
+  GstBuffer *wrapped = gst_buffer_new_wrapped_full(GST_MEMORY_FLAG_NO_SHARE, st.rgb.data(), st.rgb.size(), 0,
+                                                   st.rgb.size(), nullptr, nullptr);
+  gst_video_frame_map(&out, &rgb_info, wrapped, GST_MAP_WRITE);
+  gst_video_converter_frame(st.converter, &frame, &out);
+  const neuflow::model::ImageView view{st.rgb.data(), width, height, GST_VIDEO_FRAME_PLANE_STRIDE(&out, 0),
+                                       claim(ChannelOrder::rgb)};
+  gst_video_frame_unmap(&out);
+  gst_buffer_unref(wrapped);
+  return view;
+}
+
+bool set_format(GstNeuflow *self, State &st, GstCaps *caps) {
+  GstVideoInfo info;
+  if (!gst_video_info_from_caps(&info, caps)) return false;
+  if (st.converter) gst_video_converter_free(st.converter);
+  st.converter = nullptr;
+  const GstVideoFormat format = GST_VIDEO_INFO_FORMAT(&info);
+  if (format != GST_VIDEO_FORMAT_RGB && format != GST_VIDEO_FORMAT_BGR) {
+    GstVideoInfo rgb_info;
+    gst_video_info_set_format(&rgb_info, GST_VIDEO_FORMAT_RGB, GST_VIDEO_INFO_WIDTH(&info),
+                              GST_VIDEO_INFO_HEIGHT(&info));
+    // The converter insists on matching rates and aspect; only the format changes.
+    GST_VIDEO_INFO_FPS_N(&rgb_info) = GST_VIDEO_INFO_FPS_N(&info);
+    GST_VIDEO_INFO_FPS_D(&rgb_info) = GST_VIDEO_INFO_FPS_D(&info);
+    GST_VIDEO_INFO_PAR_N(&rgb_info) = GST_VIDEO_INFO_PAR_N(&info);
+    GST_VIDEO_INFO_PAR_D(&rgb_info) = GST_VIDEO_INFO_PAR_D(&info);
+    st.converter = gst_video_converter_new(&info, &rgb_info, nullptr);
+    if (!st.converter) return false;
+  }
+  if (st.have_info && (GST_VIDEO_INFO_WIDTH(&info) != GST_VIDEO_INFO_WIDTH(&st.info) ||
+                       GST_VIDEO_INFO_HEIGHT(&info) != GST_VIDEO_INFO_HEIGHT(&st.info))) {
+    GST_INFO_OBJECT(self, "frame size changed: the stream of flows starts anew");
+    st.session->reset();
+  }
+  st.info = info;
+  st.have_info = true;
+  return true;
+}
+
+GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guint64 frame_number,
+                            const Settings &settings) {
+  if (!st.have_info) {
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, CORE, NEGOTIATION, (nullptr), ("a frame arrived before its caps"));
+    return GST_FLOW_NOT_NEGOTIATED;
+  }
+  GstVideoFrame frame;
+  if (!gst_video_frame_map(&frame, &st.info, buffer, GST_MAP_READ)) {
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, STREAM, FAILED, ("could not map a video frame"), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  const auto started = std::chrono::steady_clock::now();
+  std::optional<neuflow::flow::FlowField> flow;
+  try {
+    flow = st.session->push(frame_view(st, frame, settings.order));
+  } catch (const std::exception &e) {
+    gst_video_frame_unmap(&frame);
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, STREAM, FAILED, ("optical flow failed: %s", e.what()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  gst_video_frame_unmap(&frame);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+  const GstClockTime pts = GST_BUFFER_PTS(buffer);
+  if (flow) {
+    buffer = gst_buffer_make_writable(buffer);
+    GBytes *bytes = g_bytes_new(flow->uv.data(), flow->uv.size() * sizeof(float));
+    NeuflowFlowMeta *meta = neuflow_buffer_add_flow_meta(buffer, flow->width, flow->height, bytes);
+    g_bytes_unref(bytes);
+    meta->from_pts = st.previous_pts;
+    meta->to_pts = pts;
+    meta->from_frame = st.previous_frame;
+    meta->to_frame = frame_number;
+    const auto &opts = st.session->options();
+    meta->model_width = opts.model_width ? opts.model_width : (flow->width + 15) / 16 * 16;
+    meta->model_height = opts.model_height ? opts.model_height : (flow->height + 15) / 16 * 16;
+    meta->iters_s16 = settings.iters_s16;
+    meta->iters_s8 = settings.iters_s8;
+    meta->inference_time = static_cast<GstClockTime>(seconds * GST_SECOND);
+  }
+  st.previous_pts = pts;
+  st.previous_frame = frame_number;
+
+  bool post = false;
+  Stats snapshot;
+  {
+    const std::lock_guard lock(st.lock);
+    ++st.stats.processed;
+    if (flow) {
+      ++st.stats.flows;
+      st.stats.inference_seconds += seconds;
+      st.stats.last_inference_seconds = seconds;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (settings.stats_interval > 0 &&
+        now - st.stats.last_message >= std::chrono::milliseconds(settings.stats_interval)) {
+      st.stats.last_message = now;
+      snapshot = st.stats;
+      post = true;
+    }
+  }
+  if (post) post_stats(self, snapshot);
+  return gst_pad_push(self->srcpad, buffer);
+}
+
+void worker_loop(gpointer data) {
+  auto *self = GST_NEUFLOW(data);
+  State &st = *self->state;
+  Item item;
+  {
+    std::unique_lock lock(st.lock);
+    st.cond.wait(lock, [&] { return st.flushing || !st.queue.empty(); });
+    if (st.flushing) {
+      lock.unlock();
+      gst_pad_pause_task(self->srcpad);
+      return;
+    }
+    item = st.queue.front();
+    st.queue.pop_front();
+    st.busy = true;
+  }
+  st.cond.notify_all();
+
+  GstFlowReturn ret = GST_FLOW_OK;
+  const Settings settings = copy_settings(self);
+  if (item.buffer) {
+    ret = process_frame(self, st, item.buffer, item.frame, settings);
+  } else {
+    GstEvent *event = item.event;
+    if (GST_EVENT_TYPE(event) == GST_EVENT_CAPS) {
+      GstCaps *caps = nullptr;
+      gst_event_parse_caps(event, &caps);
+      if (!set_format(self, st, caps)) {
+        gchar *text = gst_caps_to_string(caps);
+        GST_ELEMENT_ERROR(self, CORE, NEGOTIATION, (nullptr), ("unusable caps %s", text));
+        g_free(text);
+        ret = GST_FLOW_NOT_NEGOTIATED;
+      }
+    }
+    const bool is_eos = GST_EVENT_TYPE(event) == GST_EVENT_EOS;
+    if (!gst_pad_push_event(self->srcpad, event) && is_eos) {
+      GST_DEBUG_OBJECT(self, "downstream refused EOS");
+    }
+  }
+
+  bool pause = false;
+  {
+    const std::lock_guard lock(st.lock);
+    st.busy = false;
+    if (ret != GST_FLOW_OK) {
+      st.downstream = ret;
+      pause = true;
+    }
+  }
+  st.cond.notify_all();
+  if (pause) {
+    GST_DEBUG_OBJECT(self, "pausing worker: %s", gst_flow_get_name(ret));
+    if (ret == GST_FLOW_NOT_LINKED || ret < GST_FLOW_EOS) {
+      GST_ELEMENT_FLOW_ERROR(self, ret);
+      gst_pad_push_event(self->srcpad, gst_event_new_eos());
+    }
+    gst_pad_pause_task(self->srcpad);
+  }
+}
+
+// ---- streaming-thread side -----------------------------------------------------------------
+
+bool upstream_is_live(GstNeuflow *self) {
+  GstQuery *query = gst_query_new_latency();
+  gboolean live = FALSE;
+  if (gst_pad_peer_query(self->sinkpad, query)) gst_query_parse_latency(query, &live, nullptr, nullptr);
+  gst_query_unref(query);
+  return live;
+}
+
+void post_drop(GstNeuflow *self, GstBuffer *dropped, const GstSegment &segment, guint64 processed, guint64 drops) {
+  const GstClockTime pts = GST_BUFFER_PTS(dropped);
+  GstMessage *msg = gst_message_new_qos(GST_OBJECT(self), TRUE,
+                                        gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts),
+                                        gst_segment_to_stream_time(&segment, GST_FORMAT_TIME, pts), pts,
+                                        GST_BUFFER_DURATION(dropped));
+  gst_message_set_qos_stats(msg, GST_FORMAT_BUFFERS, processed, drops);
+  gst_element_post_message(GST_ELEMENT(self), msg);
+}
+
+GstFlowReturn sink_chain(GstPad * /*pad*/, GstObject *parent, GstBuffer *buffer) {
+  auto *self = GST_NEUFLOW(parent);
+  State &st = *self->state;
+  std::optional<bool> live;
+  {
+    const std::lock_guard lock(st.lock);
+    live = st.live;
+  }
+  if (!live) {
+    const Behaviour b = copy_settings(self).behaviour;
+    const bool resolved = b == Behaviour::automatic ? upstream_is_live(self) : b == Behaviour::live;
+    GST_INFO_OBJECT(self, "behaviour: %s", resolved ? "live" : "every-pair");
+    const std::lock_guard lock(st.lock);
+    st.live = live = resolved;
+  }
+
+  std::unique_lock lock(st.lock);
+  ++st.stats.frames_in;
+  const guint64 frame = st.next_frame++;
+  if (st.flushing) {
+    gst_buffer_unref(buffer);
+    return GST_FLOW_FLUSHING;
+  }
+  if (st.downstream != GST_FLOW_OK) {
+    gst_buffer_unref(buffer);
+    return st.downstream;
+  }
+  if (*live) {
+    // Newest wins: a frame still waiting for the worker is replaced by this one.
+    for (auto it = st.queue.begin(); it != st.queue.end();) {
+      if (it->buffer) {
+        ++st.stats.dropped;
+        GstBuffer *old = it->buffer;
+        const guint64 processed = st.stats.processed, drops = st.stats.dropped;
+        const GstSegment segment = st.segment;
+        it = st.queue.erase(it);
+        lock.unlock();
+        post_drop(self, old, segment, processed, drops);
+        gst_buffer_unref(old);
+        lock.lock();
+      } else {
+        ++it;
+      }
+    }
+  } else {
+    st.cond.wait(lock, [&] {
+      std::size_t buffers = 0;
+      for (const auto &item : st.queue) buffers += item.buffer != nullptr;
+      return st.flushing || st.downstream != GST_FLOW_OK || buffers < kEveryPairQueuedBuffers;
+    });
+    if (st.flushing || st.downstream != GST_FLOW_OK) {
+      gst_buffer_unref(buffer);
+      return st.flushing ? GST_FLOW_FLUSHING : st.downstream;
+    }
+  }
+  st.queue.push_back(Item{buffer, nullptr, frame});
+  lock.unlock();
+  st.cond.notify_all();
+  return GST_FLOW_OK;
+}
+
+gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
+  auto *self = GST_NEUFLOW(parent);
+  State &st = *self->state;
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_FLUSH_START: {
+      {
+        const std::lock_guard lock(st.lock);
+        st.flushing = true;
+        clear_queue(st);
+      }
+      st.cond.notify_all();
+      const gboolean ok = gst_pad_push_event(self->srcpad, event);
+      gst_pad_pause_task(self->srcpad);  // returns once the worker finished its current item
+      return ok;
+    }
+    case GST_EVENT_FLUSH_STOP: {
+      {
+        const std::lock_guard lock(st.lock);
+        clear_queue(st);
+        st.flushing = false;
+        st.downstream = GST_FLOW_OK;
+        if (st.session) st.session->reset();
+        st.previous_pts = GST_CLOCK_TIME_NONE;
+      }
+      const gboolean ok = gst_pad_push_event(self->srcpad, event);
+      gst_pad_start_task(self->srcpad, worker_loop, self, nullptr);
+      return ok;
+    }
+    case GST_EVENT_CAPS: {
+      GstCaps *caps = nullptr;
+      gst_event_parse_caps(event, &caps);
+      GstVideoInfo info;
+      if (!gst_video_info_from_caps(&info, caps)) {
+        gst_event_unref(event);
+        return FALSE;
+      }
+      break;  // queued below, applied by the worker in stream order
+    }
+    case GST_EVENT_SEGMENT: {
+      const GstSegment *segment = nullptr;
+      gst_event_parse_segment(event, &segment);
+      const std::lock_guard lock(st.lock);
+      gst_segment_copy_into(segment, &st.segment);
+      break;
+    }
+    case GST_EVENT_STREAM_START: {
+      const std::lock_guard lock(st.lock);
+      st.live.reset();  // a new stream may come from a source of another kind
+      break;
+    }
+    default:
+      break;
+  }
+  if (!GST_EVENT_IS_SERIALIZED(event)) return gst_pad_event_default(pad, parent, event);
+  {
+    const std::lock_guard lock(st.lock);
+    if (st.flushing) {
+      gst_event_unref(event);
+      return FALSE;
+    }
+    st.queue.push_back(Item{nullptr, event, 0});
+  }
+  st.cond.notify_all();
+  return TRUE;
+}
+
+gboolean sink_query(GstPad *pad, GstObject *parent, GstQuery *query) {
+  auto *self = GST_NEUFLOW(parent);
+  State &st = *self->state;
+  if (GST_QUERY_IS_SERIALIZED(query)) {
+    // Serialized queries (allocation, drain) must not overtake the frames queued before them.
+    std::unique_lock lock(st.lock);
+    st.cond.wait(lock, [&] { return st.flushing || (st.queue.empty() && !st.busy); });
+    if (st.flushing) return FALSE;
+  }
+  return gst_pad_query_default(pad, parent, query);
+}
+
+gboolean src_query(GstPad *pad, GstObject *parent, GstQuery *query) {
+  auto *self = GST_NEUFLOW(parent);
+  if (GST_QUERY_TYPE(query) != GST_QUERY_LATENCY) return gst_pad_query_default(pad, parent, query);
+  if (!gst_pad_peer_query(self->sinkpad, query)) return FALSE;
+  gboolean live = FALSE;
+  GstClockTime min = 0, max = GST_CLOCK_TIME_NONE;
+  gst_query_parse_latency(query, &live, &min, &max);
+  State &st = *self->state;
+  double per_frame = 0;
+  {
+    const std::lock_guard lock(st.lock);
+    per_frame = st.stats.flows ? st.stats.inference_seconds / static_cast<double>(st.stats.flows) : 0.0;
+  }
+  // A frame waits at most for the one being computed, then for its own computation.
+  const auto ours = static_cast<GstClockTime>(2 * per_frame * GST_SECOND);
+  min += ours;
+  if (GST_CLOCK_TIME_IS_VALID(max)) max += ours;
+  gst_query_set_latency(query, live, min, max);
+  return TRUE;
+}
+
+gboolean src_activate_mode(GstPad *pad, GstObject *parent, GstPadMode mode, gboolean active) {
+  auto *self = GST_NEUFLOW(parent);
+  State &st = *self->state;
+  if (mode != GST_PAD_MODE_PUSH) return FALSE;
+  if (active) {
+    {
+      const std::lock_guard lock(st.lock);
+      st.flushing = false;
+      st.downstream = GST_FLOW_OK;
+    }
+    return gst_pad_start_task(pad, worker_loop, self, nullptr);
+  }
+  {
+    const std::lock_guard lock(st.lock);
+    st.flushing = true;
+    clear_queue(st);
+  }
+  st.cond.notify_all();
+  return gst_pad_stop_task(pad);
+}
+
+// ---- lifecycle -----------------------------------------------------------------------------
+
+GstStateChangeReturn change_state(GstElement *element, GstStateChange transition) {
+  auto *self = GST_NEUFLOW(element);
+  State &st = *self->state;
+  switch (transition) {
+    case GST_STATE_CHANGE_NULL_TO_READY: {
+      const Settings s = copy_settings(self);
+      if (s.model.empty()) {
+        GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("no model given"),
+                          ("set the 'model' property to a NeuFlow-V2 checkpoint (.pth)"));
+        return GST_STATE_CHANGE_FAILURE;
+      }
+      try {
+        *self->model = FlowModel::load_shared(s.model);
+      } catch (const std::exception &e) {
+        GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("cannot load the model: %s", e.what()), (nullptr));
+        return GST_STATE_CHANGE_FAILURE;
+      }
+      break;
+    }
+    case GST_STATE_CHANGE_READY_TO_PAUSED: {
+      const Settings s = copy_settings(self);
+      neuflow::model::SessionOptions options;
+      options.iterations = {static_cast<int>(s.iters_s16), static_cast<int>(s.iters_s8)};
+      options.model_width = static_cast<int>(s.model_width);
+      options.model_height = static_cast<int>(s.model_height);
+      options.threads = static_cast<int>(s.threads);
+      try {
+        st.session = std::make_unique<FlowSession>(*self->model, options);
+      } catch (const std::exception &e) {
+        GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("invalid settings: %s", e.what()), (nullptr));
+        return GST_STATE_CHANGE_FAILURE;
+      }
+      const std::lock_guard lock(st.lock);
+      st.stats = Stats{};
+      st.stats.started = st.stats.last_message = std::chrono::steady_clock::now();
+      st.next_frame = 0;
+      st.live.reset();
+      st.have_info = false;
+      st.previous_pts = GST_CLOCK_TIME_NONE;
+      gst_segment_init(&st.segment, GST_FORMAT_TIME);
+      break;
+    }
+    default:
+      break;
+  }
+
+  const GstStateChangeReturn ret = GST_ELEMENT_CLASS(gst_neuflow_parent_class)->change_state(element, transition);
+  if (ret == GST_STATE_CHANGE_FAILURE) return ret;
+
+  switch (transition) {
+    case GST_STATE_CHANGE_PAUSED_TO_READY:  // pads are deactivated: the worker has stopped
+      st.session.reset();
+      if (st.converter) gst_video_converter_free(st.converter);
+      st.converter = nullptr;
+      st.have_info = false;
+      break;
+    case GST_STATE_CHANGE_READY_TO_NULL:
+      self->model->reset();
+      break;
+    default:
+      break;
+  }
+  return ret;
+}
+
+void set_property(GObject *object, guint id, const GValue *value, GParamSpec *pspec) {
+  auto *self = GST_NEUFLOW(object);
+  GST_OBJECT_LOCK(self);
+  Settings &s = *self->settings;
+  switch (id) {
+    case PROP_MODEL: s.model = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
+    case PROP_ITERS_S16: s.iters_s16 = g_value_get_uint(value); break;
+    case PROP_ITERS_S8: s.iters_s8 = g_value_get_uint(value); break;
+    case PROP_MODEL_WIDTH: s.model_width = g_value_get_uint(value); break;
+    case PROP_MODEL_HEIGHT: s.model_height = g_value_get_uint(value); break;
+    case PROP_THREADS: s.threads = g_value_get_uint(value); break;
+    case PROP_CHANNEL_ORDER: s.order = static_cast<ChannelOrder>(g_value_get_enum(value)); break;
+    case PROP_BEHAVIOUR: s.behaviour = static_cast<Behaviour>(g_value_get_enum(value)); break;
+    case PROP_STATS_INTERVAL: s.stats_interval = g_value_get_uint(value); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
+  auto *self = GST_NEUFLOW(object);
+  if (id >= PROP_FRAMES_IN) {
+    State &st = *self->state;
+    const std::lock_guard lock(st.lock);
+    const Stats &s = st.stats;
+    const double elapsed =
+        s.processed ? std::chrono::duration<double>(std::chrono::steady_clock::now() - s.started).count() : 0.0;
+    switch (id) {
+      case PROP_FRAMES_IN: g_value_set_uint64(value, s.frames_in); break;
+      case PROP_FRAMES_PROCESSED: g_value_set_uint64(value, s.processed); break;
+      case PROP_FRAMES_DROPPED: g_value_set_uint64(value, s.dropped); break;
+      case PROP_MEAN_LATENCY:
+        g_value_set_double(value, s.flows ? 1e3 * s.inference_seconds / static_cast<double>(s.flows) : 0.0);
+        break;
+      case PROP_PROCESSING_RATE:
+        g_value_set_double(value, elapsed > 0 ? static_cast<double>(s.processed) / elapsed : 0.0);
+        break;
+      default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    }
+    return;
+  }
+  GST_OBJECT_LOCK(self);
+  const Settings &s = *self->settings;
+  switch (id) {
+    case PROP_MODEL: g_value_set_string(value, s.model.c_str()); break;
+    case PROP_ITERS_S16: g_value_set_uint(value, s.iters_s16); break;
+    case PROP_ITERS_S8: g_value_set_uint(value, s.iters_s8); break;
+    case PROP_MODEL_WIDTH: g_value_set_uint(value, s.model_width); break;
+    case PROP_MODEL_HEIGHT: g_value_set_uint(value, s.model_height); break;
+    case PROP_THREADS: g_value_set_uint(value, s.threads); break;
+    case PROP_CHANNEL_ORDER: g_value_set_enum(value, static_cast<gint>(s.order)); break;
+    case PROP_BEHAVIOUR: g_value_set_enum(value, static_cast<gint>(s.behaviour)); break;
+    case PROP_STATS_INTERVAL: g_value_set_uint(value, s.stats_interval); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+void finalize(GObject *object) {
+  auto *self = GST_NEUFLOW(object);
+  clear_queue(*self->state);
+  if (self->state->converter) gst_video_converter_free(self->state->converter);
+  delete self->state;
+  delete self->model;
+  delete self->settings;
+  G_OBJECT_CLASS(gst_neuflow_parent_class)->finalize(object);
+}
+
+}  // namespace
+
+static void gst_neuflow_class_init(GstNeuflowClass *klass) {
+  auto *gobject_class = G_OBJECT_CLASS(klass);
+  auto *element_class = GST_ELEMENT_CLASS(klass);
+  gobject_class->set_property = set_property;
+  gobject_class->get_property = get_property;
+  gobject_class->finalize = finalize;
+  element_class->change_state = change_state;
+
+  constexpr auto rw = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                               GST_PARAM_MUTABLE_READY);
+  constexpr auto ro = static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS);
+  // The model is loaded when the element leaves NULL, so it can only change in NULL.
+  constexpr auto rw_null = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS);
+  g_object_class_install_property(
+      gobject_class, PROP_MODEL,
+      g_param_spec_string("model", "Model", "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth; loaded once when "
+                          "the element leaves NULL and shared with other elements using the same file",
+                          nullptr, rw_null));
+  g_object_class_install_property(
+      gobject_class, PROP_ITERS_S16,
+      g_param_spec_uint("iters-s16", "Iterations at 1/16", "Refinement iterations at 1/16 resolution", 0, 32,
+                        DEFAULT_ITERS_S16, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_ITERS_S8,
+      g_param_spec_uint("iters-s8", "Iterations at 1/8", "Refinement iterations at 1/8 resolution", 0, 64,
+                        DEFAULT_ITERS_S8, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_MODEL_WIDTH,
+      g_param_spec_uint("model-width", "Model width",
+                        "Width the network runs at (multiple of 16); 0: the frame's own size, edge-padded", 0, 16384,
+                        DEFAULT_MODEL_SIZE, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_MODEL_HEIGHT,
+      g_param_spec_uint("model-height", "Model height",
+                        "Height the network runs at (multiple of 16); 0: the frame's own size, edge-padded", 0,
+                        16384, DEFAULT_MODEL_SIZE, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_THREADS,
+      g_param_spec_uint("threads", "Threads", "CPU threads for inference (0: all cores)", 0, 1024, DEFAULT_THREADS,
+                        rw));
+  g_object_class_install_property(
+      gobject_class, PROP_CHANNEL_ORDER,
+      g_param_spec_enum("channel-order", "Channel order", "Colour order fed to the network", channel_order_get_type(),
+                        static_cast<gint>(ChannelOrder::rgb), rw));
+  g_object_class_install_property(
+      gobject_class, PROP_BEHAVIOUR,
+      g_param_spec_enum("behaviour", "Behaviour",
+                        "live: hold real-time by dropping frames; every-pair: compute every consecutive pair",
+                        behaviour_get_type(), static_cast<gint>(Behaviour::automatic), rw));
+  g_object_class_install_property(
+      gobject_class, PROP_STATS_INTERVAL,
+      g_param_spec_uint("stats-interval", "Stats interval",
+                        "Milliseconds between 'neuflow-stats' element messages carrying the counters (0: none)", 0,
+                        G_MAXUINT, DEFAULT_STATS_INTERVAL,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_PLAYING)));
+  g_object_class_install_property(
+      gobject_class, PROP_FRAMES_IN,
+      g_param_spec_uint64("frames-in", "Frames in", "Frames received", 0, G_MAXUINT64, 0, ro));
+  g_object_class_install_property(
+      gobject_class, PROP_FRAMES_PROCESSED,
+      g_param_spec_uint64("frames-processed", "Frames processed", "Frames that left the element", 0, G_MAXUINT64, 0,
+                          ro));
+  g_object_class_install_property(
+      gobject_class, PROP_FRAMES_DROPPED,
+      g_param_spec_uint64("frames-dropped", "Frames dropped", "Frames dropped to hold real-time (live behaviour)", 0,
+                          G_MAXUINT64, 0, ro));
+  g_object_class_install_property(
+      gobject_class, PROP_MEAN_LATENCY,
+      g_param_spec_double("mean-latency", "Mean latency", "Mean inference time per flow, milliseconds", 0,
+                          G_MAXDOUBLE, 0, ro));
+  g_object_class_install_property(
+      gobject_class, PROP_PROCESSING_RATE,
+      g_param_spec_double("processing-rate", "Processing rate", "Frames leaving the element per second", 0,
+                          G_MAXDOUBLE, 0, ro));
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+  gst_element_class_set_static_metadata(element_class, "NeuFlow-V2 optical flow", "Filter/Analyzer/Video",
+                                        "Computes optical flow between video frames and attaches it as metadata",
+                                        "neuflow");
+  gst_type_mark_as_plugin_api(channel_order_get_type(), static_cast<GstPluginAPIFlags>(0));
+  gst_type_mark_as_plugin_api(behaviour_get_type(), static_cast<GstPluginAPIFlags>(0));
+  GST_DEBUG_CATEGORY_INIT(gst_neuflow_debug, "neuflow", 0, "NeuFlow-V2 optical flow element");
+}
+
+static void gst_neuflow_init(GstNeuflow *self) {
+  self->settings = new Settings();
+  self->model = new std::shared_ptr<const FlowModel>();
+  self->state = new State();
+  gst_segment_init(&self->state->segment, GST_FORMAT_TIME);
+
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, sink_chain);
+  gst_pad_set_event_function(self->sinkpad, sink_event);
+  gst_pad_set_query_function(self->sinkpad, sink_query);
+  GST_PAD_SET_PROXY_CAPS(self->sinkpad);
+  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
+
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  gst_pad_set_query_function(self->srcpad, src_query);
+  gst_pad_set_activatemode_function(self->srcpad, src_activate_mode);
+  GST_PAD_SET_PROXY_CAPS(self->srcpad);
+  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+}

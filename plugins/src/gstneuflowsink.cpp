@@ -1,0 +1,448 @@
+/**
+ * SECTION:element-neuflowsink
+ * @title: neuflowsink
+ *
+ * Writes the optical flow attached to each video frame (#NeuflowFlowMeta, from the
+ * `neuflow` element) to numbered flow files, one per frame that carries flow, like
+ * `multifilesink` does for buffers. #neuflowsink:location is a printf-style pattern with
+ * exactly one integer conversion for the file index (`%d`, `%05d`, `%x`...); its extension
+ * picks the format: `.flo` (Middlebury), `.npy` (NumPy H×W×2 float32) or `.png` (KITTI 16-bit,
+ * quantized to 1/64 px). The file holds the flow grid as it is in the meta (its own width and
+ * height, vectors in pixels of the grid). Each file is written to a temporary name and
+ * renamed, so a reader never sees a partial file.
+ *
+ * A CSV index (#neuflowsink:index-location, by default `index.csv` beside the flow files)
+ * gets one row per file written, flushed at once:
+ * `index,from_frame,to_frame,from_pts_ns,to_pts_ns,file`. The frame numbers and
+ * timestamps are those of the two frames the flow was computed from; after dropped frames
+ * they are not consecutive, so consumers should pair flows with frames through this file.
+ *
+ * Buffers without flow (the first frame of a stream, frames the inference element dropped)
+ * are skipped and counted in #neuflowsink:buffers-skipped. A file that cannot be written
+ * (missing directory, disk full, no permission) stops the pipeline with an error naming
+ * the file and the reason.
+ *
+ * As a file writer, the sink does not synchronize to the clock by default (sync=false).
+ *
+ * ## Example launch line
+ * |[
+ * gst-launch-1.0 filesrc location=in.mp4 ! decodebin ! videoconvert ! neuflow ! neuflowsink location=out/flow_%05d.flo
+ * ]|
+ */
+#include <gst/base/gstbasesink.h>
+#include <gst/gst.h>
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cinttypes>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "elements.hpp"
+#include "neuflow/flow/errors.hpp"
+#include "neuflow/flow/flow_field.hpp"
+#include "neuflow/flow/flow_io.hpp"
+#include "neuflow/gst/flow_meta.h"
+
+GST_DEBUG_CATEGORY_STATIC(gst_neuflow_sink_debug);
+#define GST_CAT_DEFAULT gst_neuflow_sink_debug
+
+enum {
+  PROP_0,
+  PROP_LOCATION,
+  PROP_INDEX,
+  PROP_INDEX_LOCATION,
+  PROP_FLOWS_WRITTEN,
+  PROP_BUFFERS_SKIPPED,
+};
+
+#define DEFAULT_LOCATION "flow_%05d.flo"
+#define DEFAULT_INDEX 0
+#define DEFAULT_INDEX_LOCATION nullptr /* index.csv in the directory of location */
+#define INDEX_FILE_NAME "index.csv"
+#define INDEX_HEADER "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file\n"
+
+struct GstNeuflowSink {
+  GstBaseSink parent;
+
+  // Properties, under the object lock.
+  gchar *location;
+  gchar *index_location;
+  gint index;  // of the next file
+  guint64 flows_written;
+  guint64 buffers_skipped;
+
+  // From start() to stop(), streaming thread only.
+  gchar *pattern;          // location, validated
+  gchar *index_path;       // where the index goes, or nullptr when disabled
+  gchar *index_dir;        // its directory, to name files beside it by their base name
+  FILE *index_file;        // opened at the first flow written
+};
+
+struct GstNeuflowSinkClass {
+  GstBaseSinkClass parent_class;
+};
+
+#define GST_NEUFLOW_SINK(obj) (reinterpret_cast<GstNeuflowSink *>(obj))
+
+G_DEFINE_TYPE_WITH_CODE(GstNeuflowSink, gst_neuflow_sink, GST_TYPE_BASE_SINK,
+                        GST_DEBUG_CATEGORY_INIT(gst_neuflow_sink_debug, "neuflowsink", 0,
+                                                "NeuFlow optical flow file writer"))
+
+static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS_ANY);
+
+namespace {
+
+// Checks that `pattern` holds exactly one integer conversion (%d, %i, %u, %x, %X or %o with
+// optional flags, width and precision, no length modifier) and nothing else that printf
+// would interpret apart from "%%". Returns a description of the problem, or nullopt.
+std::optional<std::string> check_location_pattern(const char *pattern) {
+  int conversions = 0;
+  for (const char *p = pattern; *p; ++p) {
+    if (*p != '%') continue;
+    const char *start = p++;
+    if (*p == '%') continue;
+    while (*p && std::strchr("-+ #0", *p)) ++p;
+    while (g_ascii_isdigit(*p)) ++p;
+    if (*p == '.') {
+      ++p;
+      while (g_ascii_isdigit(*p)) ++p;
+    }
+    if (*p && std::strchr("diuxXo", *p)) {
+      ++conversions;
+      continue;
+    }
+    const std::string spec(start, *p ? static_cast<std::size_t>(p - start) + 1 : static_cast<std::size_t>(p - start));
+    return "\"" + spec + "\" is not an integer conversion (use one of %d, %05d, %u, %x, and %% for a literal %)";
+  }
+  if (conversions != 1) {
+    return "it must contain exactly one integer conversion such as %05d for the file index, found " +
+           std::to_string(conversions);
+  }
+  return std::nullopt;
+}
+
+// The file name for `index`; `pattern` has passed check_location_pattern, which makes the
+// non-literal format safe: one int argument for one integer conversion.
+std::string format_location(const char *pattern, gint index) {
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+  gchar *name = g_strdup_printf(pattern, index);
+#pragma GCC diagnostic pop
+  std::string out(name);
+  g_free(name);
+  return out;
+}
+
+// A CSV field, quoted when it holds a separator, a quote or a line break (RFC 4180).
+std::string csv_field(const std::string &s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string clock_time_field(GstClockTime t) {
+  return GST_CLOCK_TIME_IS_VALID(t) ? std::to_string(t) : std::string();
+}
+
+bool is_directory(const char *path) { return g_file_test(path, G_FILE_TEST_IS_DIR); }
+
+}  // namespace
+
+static void gst_neuflow_sink_set_property(GObject *object, guint prop_id, const GValue *value, GParamSpec *pspec) {
+  GstNeuflowSink *self = GST_NEUFLOW_SINK(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_LOCATION:
+      g_free(self->location);
+      self->location = g_value_dup_string(value);
+      break;
+    case PROP_INDEX:
+      self->index = g_value_get_int(value);
+      break;
+    case PROP_INDEX_LOCATION:
+      g_free(self->index_location);
+      self->index_location = g_value_dup_string(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_neuflow_sink_get_property(GObject *object, guint prop_id, GValue *value, GParamSpec *pspec) {
+  GstNeuflowSink *self = GST_NEUFLOW_SINK(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_LOCATION:
+      g_value_set_string(value, self->location);
+      break;
+    case PROP_INDEX:
+      g_value_set_int(value, self->index);
+      break;
+    case PROP_INDEX_LOCATION:
+      g_value_set_string(value, self->index_location);
+      break;
+    case PROP_FLOWS_WRITTEN:
+      g_value_set_uint64(value, self->flows_written);
+      break;
+    case PROP_BUFFERS_SKIPPED:
+      g_value_set_uint64(value, self->buffers_skipped);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_neuflow_sink_clear_run_state(GstNeuflowSink *self) {
+  if (self->index_file) {
+    std::fclose(self->index_file);
+    self->index_file = nullptr;
+  }
+  g_clear_pointer(&self->pattern, g_free);
+  g_clear_pointer(&self->index_path, g_free);
+  g_clear_pointer(&self->index_dir, g_free);
+}
+
+static void gst_neuflow_sink_finalize(GObject *object) {
+  GstNeuflowSink *self = GST_NEUFLOW_SINK(object);
+  gst_neuflow_sink_clear_run_state(self);
+  g_free(self->location);
+  g_free(self->index_location);
+  G_OBJECT_CLASS(gst_neuflow_sink_parent_class)->finalize(object);
+}
+
+// Validates the settings and checks that the output directories exist, so that a typo shows
+// up when the pipeline starts rather than at the first flow. Files are created only when
+// there is flow to write.
+static gboolean gst_neuflow_sink_start(GstBaseSink *sink) {
+  GstNeuflowSink *self = GST_NEUFLOW_SINK(sink);
+
+  GST_OBJECT_LOCK(self);
+  g_autofree gchar *location = g_strdup(self->location);
+  g_autofree gchar *index_location = g_strdup(self->index_location);
+  const gint index = self->index;
+  self->flows_written = 0;
+  self->buffers_skipped = 0;
+  GST_OBJECT_UNLOCK(self);
+
+  if (!location || !*location) {
+    GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("No location set for the flow files."),
+                      ("set the location property, e.g. location=flow_%%05d.flo"));
+    return FALSE;
+  }
+  if (auto problem = check_location_pattern(location)) {
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Invalid flow file location \"%s\": %s.", location, problem->c_str()),
+                      (nullptr));
+    return FALSE;
+  }
+  if (!neuflow::flow::flow_format_from_path(format_location(location, index))) {
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS,
+                      ("Invalid flow file location \"%s\": the extension must be .flo, .npy or .png.", location),
+                      (nullptr));
+    return FALSE;
+  }
+  g_autofree gchar *dir = g_path_get_dirname(location);
+  if (!is_directory(dir)) {
+    GST_ELEMENT_ERROR(self, RESOURCE, OPEN_WRITE,
+                      ("Cannot write flow files \"%s\": directory \"%s\" does not exist.", location, dir), (nullptr));
+    return FALSE;
+  }
+
+  g_autofree gchar *index_path = nullptr;
+  if (!index_location) {
+    index_path = g_build_filename(dir, INDEX_FILE_NAME, nullptr);
+  } else if (*index_location) {
+    index_path = g_strdup(index_location);
+  }
+  g_autofree gchar *index_dir = index_path ? g_path_get_dirname(index_path) : nullptr;
+  if (index_dir && !is_directory(index_dir)) {
+    GST_ELEMENT_ERROR(self, RESOURCE, OPEN_WRITE,
+                      ("Cannot write the flow index \"%s\": directory \"%s\" does not exist.", index_path, index_dir),
+                      (nullptr));
+    return FALSE;
+  }
+
+  GST_INFO_OBJECT(self, "writing flow to %s from index %d, index file %s", location, index,
+                  index_path ? index_path : "(none)");
+  gst_neuflow_sink_clear_run_state(self);
+  self->pattern = g_steal_pointer(&location);
+  self->index_path = g_steal_pointer(&index_path);
+  self->index_dir = g_steal_pointer(&index_dir);
+  return TRUE;
+}
+
+static gboolean gst_neuflow_sink_stop(GstBaseSink *sink) {
+  GstNeuflowSink *self = GST_NEUFLOW_SINK(sink);
+  GST_OBJECT_LOCK(self);
+  GST_INFO_OBJECT(self, "wrote %" G_GUINT64_FORMAT " flow files, skipped %" G_GUINT64_FORMAT " buffers without flow",
+                  self->flows_written, self->buffers_skipped);
+  GST_OBJECT_UNLOCK(self);
+  gst_neuflow_sink_clear_run_state(self);
+  return TRUE;
+}
+
+// Appends one row to the index, opening it (and writing the header into an empty file)
+// the first time. Rows are appended, never rewritten: after a restart that reuses indices,
+// the last row for an index describes the file now on disk.
+static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, const NeuflowFlowMeta *meta,
+                                          const std::string &file) {
+  if (!self->index_path) return true;
+  if (!self->index_file) {
+    self->index_file = std::fopen(self->index_path, "a");
+    struct stat st {};
+    if (!self->index_file || fstat(fileno(self->index_file), &st) != 0 ||
+        (st.st_size == 0 && std::fputs(INDEX_HEADER, self->index_file) == EOF)) {
+      const int err = errno;
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_WRITE,
+                        ("Could not open the flow index \"%s\" for appending: %s.", self->index_path, g_strerror(err)),
+                        (nullptr));
+      return false;
+    }
+  }
+
+  // Files beside the index are named by their base name, so the directory can be moved.
+  gchar *file_dir = g_path_get_dirname(file.c_str());
+  std::string name = file;
+  if (std::strcmp(file_dir, self->index_dir) == 0) {
+    gchar *base = g_path_get_basename(file.c_str());
+    name = base;
+    g_free(base);
+  }
+  g_free(file_dir);
+
+  const std::string row = std::to_string(index) + "," + std::to_string(meta->from_frame) + "," +
+                          std::to_string(meta->to_frame) + "," + clock_time_field(meta->from_pts) + "," +
+                          clock_time_field(meta->to_pts) + "," + csv_field(name) + "\n";
+  if (std::fputs(row.c_str(), self->index_file) == EOF || std::fflush(self->index_file) != 0) {
+    const int err = errno;
+    GST_ELEMENT_ERROR(self, RESOURCE, WRITE,
+                      ("Could not append to the flow index \"%s\": %s.", self->index_path, g_strerror(err)),
+                      (nullptr));
+    return false;
+  }
+  return true;
+}
+
+static GstFlowReturn gst_neuflow_sink_render(GstBaseSink *sink, GstBuffer *buffer) {
+  GstNeuflowSink *self = GST_NEUFLOW_SINK(sink);
+  const NeuflowFlowMeta *meta = neuflow_buffer_get_flow_meta(buffer);
+  if (!meta || meta->width == 0 || meta->height == 0) {
+    GST_OBJECT_LOCK(self);
+    ++self->buffers_skipped;
+    GST_OBJECT_UNLOCK(self);
+    GST_LOG_OBJECT(self, "buffer %" GST_TIME_FORMAT " has no flow: skipped", GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
+    return GST_FLOW_OK;
+  }
+
+  GST_OBJECT_LOCK(self);
+  const gint index = self->index;
+  GST_OBJECT_UNLOCK(self);
+  const std::string path = format_location(self->pattern, index);
+
+  try {
+    neuflow::flow::FlowField field(static_cast<int>(meta->width), static_cast<int>(meta->height));
+    const gfloat *vectors = neuflow_flow_meta_get_vectors(meta);
+    std::memcpy(field.uv.data(), vectors, field.uv.size() * sizeof(float));
+    neuflow::flow::write_flow(field, path);
+  } catch (const neuflow::flow::FlowFileError &e) {
+    GST_ELEMENT_ERROR(self, RESOURCE, WRITE, ("Could not write the flow file \"%s\": %s.", path.c_str(), e.problem().c_str()),
+                      ("%s", e.what()));
+    return GST_FLOW_ERROR;
+  } catch (const std::exception &e) {
+    GST_ELEMENT_ERROR(self, RESOURCE, WRITE, ("Could not write the flow file \"%s\": %s.", path.c_str(), e.what()),
+                      (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  GST_LOG_OBJECT(self, "wrote %s: %ux%u, frames %" G_GUINT64_FORMAT " -> %" G_GUINT64_FORMAT, path.c_str(),
+                 meta->width, meta->height, meta->from_frame, meta->to_frame);
+
+  if (!gst_neuflow_sink_append_index(self, index, meta, path)) return GST_FLOW_ERROR;
+
+  GST_OBJECT_LOCK(self);
+  self->index = index + 1;
+  ++self->flows_written;
+  GST_OBJECT_UNLOCK(self);
+  return GST_FLOW_OK;
+}
+
+static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
+  GObjectClass *gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass *element_class = GST_ELEMENT_CLASS(klass);
+  GstBaseSinkClass *sink_class = GST_BASE_SINK_CLASS(klass);
+
+  gobject_class->set_property = gst_neuflow_sink_set_property;
+  gobject_class->get_property = gst_neuflow_sink_get_property;
+  gobject_class->finalize = gst_neuflow_sink_finalize;
+
+  constexpr auto rw_ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
+  constexpr auto ro = static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS);
+
+  g_object_class_install_property(
+      gobject_class, PROP_LOCATION,
+      g_param_spec_string("location", "File location",
+                          "Pattern of the flow file names, with exactly one printf integer conversion for the "
+                          "index (e.g. flow_%05d.flo); the extension picks the format: .flo (Middlebury), .npy "
+                          "(NumPy H x W x 2 float32) or .png (KITTI 16-bit). The directory must exist",
+                          DEFAULT_LOCATION, rw_ready));
+  g_object_class_install_property(
+      gobject_class, PROP_INDEX,
+      g_param_spec_int("index", "Index",
+                       "Index of the next flow file in the location pattern; incremented after each file written "
+                       "(buffers without flow do not use an index)",
+                       0, G_MAXINT, DEFAULT_INDEX,
+                       static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
+  g_object_class_install_property(
+      gobject_class, PROP_INDEX_LOCATION,
+      g_param_spec_string("index-location", "Index file location",
+                          "CSV file that gets one row per flow file, flushed at once: "
+                          "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file (timestamps in ns, empty when "
+                          "unknown; file by its base name when it lies beside the index, else as written). Rows are "
+                          "appended; the header is written into an empty file. Unset: index.csv in the directory "
+                          "of location; empty string: no index",
+                          DEFAULT_INDEX_LOCATION, rw_ready));
+  g_object_class_install_property(
+      gobject_class, PROP_FLOWS_WRITTEN,
+      g_param_spec_uint64("flows-written", "Flows written", "Flow files written since the element started", 0,
+                          G_MAXUINT64, 0, ro));
+  g_object_class_install_property(
+      gobject_class, PROP_BUFFERS_SKIPPED,
+      g_param_spec_uint64("buffers-skipped", "Buffers skipped",
+                          "Buffers without flow (no NeuflowFlowMeta) since the element started", 0, G_MAXUINT64, 0,
+                          ro));
+
+  gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow file sink", "Sink/File/Video/Analyzer",
+                                        "Writes the optical flow attached to video frames (NeuflowFlowMeta) to "
+                                        "numbered .flo, .npy or KITTI .png files with a CSV index",
+                                        "neuflow");
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+
+  sink_class->start = GST_DEBUG_FUNCPTR(gst_neuflow_sink_start);
+  sink_class->stop = GST_DEBUG_FUNCPTR(gst_neuflow_sink_stop);
+  sink_class->render = GST_DEBUG_FUNCPTR(gst_neuflow_sink_render);
+}
+
+static void gst_neuflow_sink_init(GstNeuflowSink *self) {
+  self->location = g_strdup(DEFAULT_LOCATION);
+  self->index_location = nullptr;
+  self->index = DEFAULT_INDEX;
+  self->flows_written = 0;
+  self->buffers_skipped = 0;
+  self->pattern = nullptr;
+  self->index_path = nullptr;
+  self->index_dir = nullptr;
+  self->index_file = nullptr;
+  gst_base_sink_set_sync(GST_BASE_SINK(self), FALSE);  // a file writer, like filesink
+}

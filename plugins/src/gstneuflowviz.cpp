@@ -1,0 +1,532 @@
+/**
+ * SECTION:element-neuflowviz
+ * @title: neuflowviz
+ *
+ * Draws the optical flow that rides on each video frame as a #NeuflowFlowMeta (attached by
+ * the `neuflow` element), using the colour wheel of the Middlebury/Sintel flow tools:
+ * hue is the direction (right = red, down = yellow, left = cyan, up = blue/violet), and
+ * saturation the magnitude relative to #neuflowviz:max-flow (white = no motion; vectors
+ * beyond it are drawn fully saturated and dimmed to 75%).
+ *
+ * The flow grid may be smaller than the frame (the network runs at a reduced resolution):
+ * it is stretched over the whole frame and its vectors are scaled to frame pixels
+ * (by frame width / grid width and frame height / grid height) before colouring, so
+ * #neuflowviz:max-flow is always in pixels of the frame being drawn on.
+ *
+ * In `flow` mode the frame is replaced by the flow image; in `overlay` mode the flow image
+ * is blended over the video with #neuflowviz:alpha. #neuflowviz:arrows adds a grid of
+ * arrows showing the displacement itself. Frames without a flow meta (the first frame of a
+ * stream, frames the inference element dropped) pass through unchanged and uncopied.
+ *
+ * ## Example launch line
+ * |[
+ * gst-launch-1.0 v4l2src ! videoconvert ! neuflow ! videoconvert ! neuflowviz max-flow=30 mode=overlay alpha=0.6 arrows=true ! videoconvert ! autovideosink
+ * ]|
+ */
+#include <gst/gst.h>
+#include <gst/video/gstvideofilter.h>
+#include <gst/video/video.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <optional>
+#include <vector>
+
+#include "elements.hpp"
+#include "neuflow/flow/flow_field.hpp"
+#include "neuflow/flow/visualize.hpp"
+#include "neuflow/gst/flow_meta.h"
+
+GST_DEBUG_CATEGORY_STATIC(gst_neuflow_viz_debug);
+#define GST_CAT_DEFAULT gst_neuflow_viz_debug
+
+/* How the flow is drawn. */
+typedef enum {
+  GST_NEUFLOW_VIZ_MODE_OVERLAY = 0,
+  GST_NEUFLOW_VIZ_MODE_FLOW = 1,
+} GstNeuflowVizMode;
+
+#define GST_TYPE_NEUFLOW_VIZ_MODE (gst_neuflow_viz_mode_get_type())
+
+static GType gst_neuflow_viz_mode_get_type(void) {
+  static GType type = 0;
+  static const GEnumValue values[] = {
+      {GST_NEUFLOW_VIZ_MODE_OVERLAY, "Blend the flow colours over the video (see alpha)", "overlay"},
+      {GST_NEUFLOW_VIZ_MODE_FLOW, "Replace the video by the flow image", "flow"},
+      {0, nullptr, nullptr},
+  };
+  if (g_once_init_enter(&type)) {
+    GType t = g_enum_register_static("GstNeuflowVizMode", values);
+    g_once_init_leave(&type, t);
+  }
+  return type;
+}
+
+enum {
+  PROP_0,
+  PROP_MAX_FLOW,
+  PROP_MODE,
+  PROP_ALPHA,
+  PROP_ARROWS,
+  PROP_ARROW_SPACING,
+  PROP_ARROW_COLOR,
+};
+
+#define DEFAULT_MAX_FLOW 20.0
+#define DEFAULT_MODE GST_NEUFLOW_VIZ_MODE_FLOW
+#define DEFAULT_ALPHA 0.6
+#define DEFAULT_ARROWS FALSE
+#define DEFAULT_ARROW_SPACING 24u
+#define DEFAULT_ARROW_COLOR 0xff000000u /* opaque black, 0xAARRGGBB */
+
+#define MIN_ARROW_SPACING 4u
+#define MAX_ARROW_SPACING 4096u
+#define MAX_MAX_FLOW 1e6
+
+namespace {
+
+struct VizSettings {
+  gdouble max_flow = DEFAULT_MAX_FLOW;
+  GstNeuflowVizMode mode = DEFAULT_MODE;
+  gdouble alpha = DEFAULT_ALPHA;
+  gboolean arrows = DEFAULT_ARROWS;
+  guint arrow_spacing = DEFAULT_ARROW_SPACING;
+  guint arrow_color = DEFAULT_ARROW_COLOR;
+};
+
+// Where R, G and B sit inside one pixel of the negotiated packed format; chosen once per
+// caps in set_info, so one drawing routine serves every format.
+struct PixelLayout {
+  int r = 0, g = 1, b = 2;
+  int stride = 3;  // bytes per pixel
+};
+
+// Per-frame scratch kept between frames to avoid reallocating: the grid with vectors in
+// frame pixels, and the bilinear sampling tables from frame columns to grid columns.
+struct VizScratch {
+  neuflow::flow::FlowField field;
+  std::vector<int> x0, x1, wx;  // column -> grid columns and weight of x1 (0..256)
+  std::vector<int> y0, y1, wy;  // the same for rows
+};
+
+}  // namespace
+
+struct GstNeuflowViz {
+  GstVideoFilter parent;
+
+  VizSettings settings;  // properties, under the object lock
+
+  // Streaming thread only.
+  PixelLayout layout;
+  VizScratch *scratch;
+};
+
+struct GstNeuflowVizClass {
+  GstVideoFilterClass parent_class;
+};
+
+#define GST_NEUFLOW_VIZ(obj) (reinterpret_cast<GstNeuflowViz *>(obj))
+
+G_DEFINE_TYPE_WITH_CODE(GstNeuflowViz, gst_neuflow_viz, GST_TYPE_VIDEO_FILTER,
+                        GST_DEBUG_CATEGORY_INIT(gst_neuflow_viz_debug, "neuflowviz", 0,
+                                                "NeuFlow optical flow visualization"))
+
+#define VIZ_FORMATS "{ RGB, BGR, RGBx, BGRx, xRGB, xBGR, RGBA, BGRA, ARGB, ABGR }"
+
+static GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(VIZ_FORMATS)));
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(VIZ_FORMATS)));
+
+namespace {
+
+inline std::uint8_t blend(int under, int over, int weight256) {
+  return static_cast<std::uint8_t>((under * (256 - weight256) + over * weight256 + 128) >> 8);
+}
+
+// Sampling tables mapping n output positions onto a grid of m cells, pixel centres aligned,
+// clamped at the borders: output i takes (1 - w) * cell i0 + w * cell i1, w in 1/256.
+void bilinear_tables(int n, int m, std::vector<int> &i0, std::vector<int> &i1, std::vector<int> &w) {
+  i0.resize(static_cast<std::size_t>(n));
+  i1.resize(static_cast<std::size_t>(n));
+  w.resize(static_cast<std::size_t>(n));
+  const double scale = static_cast<double>(m) / n;
+  for (int i = 0; i < n; ++i) {
+    const double g = std::clamp((i + 0.5) * scale - 0.5, 0.0, static_cast<double>(m - 1));
+    const int lo = std::min(static_cast<int>(g), m - 1);
+    const auto k = static_cast<std::size_t>(i);
+    i0[k] = lo;
+    i1[k] = std::min(lo + 1, m - 1);
+    w[k] = static_cast<int>(std::lround((g - lo) * 256.0));
+  }
+}
+
+// Writes the flow colours (grid image stretched bilinearly to the frame) into the frame,
+// replacing it (weight 256) or blending over it.
+void compose_flow(GstVideoFrame *frame, const PixelLayout &px, const neuflow::flow::RgbImage &image, VizScratch &s,
+                  int weight256) {
+  const int fw = GST_VIDEO_FRAME_WIDTH(frame);
+  const int fh = GST_VIDEO_FRAME_HEIGHT(frame);
+  auto *data = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0));
+  const int stride = GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0);
+  const int gw = image.width;
+  bilinear_tables(fw, gw, s.x0, s.x1, s.wx);
+  bilinear_tables(fh, image.height, s.y0, s.y1, s.wy);
+
+  const std::uint8_t *rgb = image.rgb.data();
+  for (int y = 0; y < fh; ++y) {
+    const auto ky = static_cast<std::size_t>(y);
+    const std::uint8_t *row0 = rgb + 3 * static_cast<std::size_t>(s.y0[ky]) * static_cast<std::size_t>(gw);
+    const std::uint8_t *row1 = rgb + 3 * static_cast<std::size_t>(s.y1[ky]) * static_cast<std::size_t>(gw);
+    const int b = s.wy[ky], a = 256 - b;
+    std::uint8_t *out = data + static_cast<std::ptrdiff_t>(y) * stride;
+    for (int x = 0; x < fw; ++x, out += px.stride) {
+      const auto kx = static_cast<std::size_t>(x);
+      const std::size_t c0 = 3 * static_cast<std::size_t>(s.x0[kx]);
+      const std::size_t c1 = 3 * static_cast<std::size_t>(s.x1[kx]);
+      const int d = s.wx[kx], c = 256 - d;
+      int col[3];
+      for (std::size_t ch = 0; ch < 3; ++ch) {
+        const int top = row0[c0 + ch] * c + row0[c1 + ch] * d;
+        const int bottom = row1[c0 + ch] * c + row1[c1 + ch] * d;
+        col[ch] = (top * a + bottom * b + (1 << 15)) >> 16;
+      }
+      if (weight256 >= 256) {
+        out[px.r] = static_cast<std::uint8_t>(col[0]);
+        out[px.g] = static_cast<std::uint8_t>(col[1]);
+        out[px.b] = static_cast<std::uint8_t>(col[2]);
+      } else {
+        out[px.r] = blend(out[px.r], col[0], weight256);
+        out[px.g] = blend(out[px.g], col[1], weight256);
+        out[px.b] = blend(out[px.b], col[2], weight256);
+      }
+    }
+  }
+}
+
+// Draws into one frame with a colour given as 0xAARRGGBB.
+class Painter {
+ public:
+  Painter(GstVideoFrame *frame, const PixelLayout &px, guint argb)
+      : data_(static_cast<std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0))),
+        stride_(GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0)),
+        width_(GST_VIDEO_FRAME_WIDTH(frame)),
+        height_(GST_VIDEO_FRAME_HEIGHT(frame)),
+        px_(px),
+        r_(static_cast<int>((argb >> 16) & 0xff)),
+        g_(static_cast<int>((argb >> 8) & 0xff)),
+        b_(static_cast<int>(argb & 0xff)),
+        a_(static_cast<int>((argb >> 24) & 0xff)) {}
+
+  void dot(int x, int y) {
+    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
+    std::uint8_t *p = data_ + static_cast<std::ptrdiff_t>(y) * stride_ + static_cast<std::ptrdiff_t>(x) * px_.stride;
+    p[px_.r] = mix(p[px_.r], r_);
+    p[px_.g] = mix(p[px_.g], g_);
+    p[px_.b] = mix(p[px_.b], b_);
+  }
+
+  // A one-pixel line, clipped to the frame first (Liang–Barsky) so that absurd vectors cost
+  // no more than the frame's diagonal.
+  void line(double xa, double ya, double xb, double yb) {
+    if (!clip(xa, ya, xb, yb)) return;
+    int x = static_cast<int>(std::lround(xa)), y = static_cast<int>(std::lround(ya));
+    const int x_end = static_cast<int>(std::lround(xb)), y_end = static_cast<int>(std::lround(yb));
+    const int dx = std::abs(x_end - x), dy = -std::abs(y_end - y);
+    const int step_x = x < x_end ? 1 : -1, step_y = y < y_end ? 1 : -1;
+    int err = dx + dy;
+    for (;;) {  // Bresenham
+      dot(x, y);
+      if (x == x_end && y == y_end) break;
+      const int e2 = 2 * err;
+      if (e2 >= dy) {
+        err += dy;
+        x += step_x;
+      }
+      if (e2 <= dx) {
+        err += dx;
+        y += step_y;
+      }
+    }
+  }
+
+  // An arrow from (x, y) along (u, v), with a head scaled to its length and the grid spacing.
+  void arrow(double x, double y, double u, double v, double spacing) {
+    dot(static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)));
+    const double len = std::hypot(u, v);
+    if (!(len >= 1.0) || !std::isfinite(len)) return;  // under a pixel (or not finite): just the anchor
+    const double xe = x + u, ye = y + v;
+    line(x, y, xe, ye);
+    const double head = std::clamp(0.3 * len, 2.0, std::max(2.0, 0.4 * spacing));
+    const double angle = std::atan2(v, u);
+    constexpr double kSpread = 0.45;  // ~26 degrees either side of the shaft
+    line(xe, ye, xe - head * std::cos(angle - kSpread), ye - head * std::sin(angle - kSpread));
+    line(xe, ye, xe - head * std::cos(angle + kSpread), ye - head * std::sin(angle + kSpread));
+  }
+
+ private:
+  std::uint8_t mix(int under, int over) const {
+    return static_cast<std::uint8_t>((under * (255 - a_) + over * a_ + 127) / 255);
+  }
+
+  bool clip(double &xa, double &ya, double &xb, double &yb) const {
+    const double dx = xb - xa, dy = yb - ya;
+    double t0 = 0, t1 = 1;
+    const double p[4] = {-dx, dx, -dy, dy};
+    const double q[4] = {xa, (width_ - 1) - xa, ya, (height_ - 1) - ya};
+    for (int i = 0; i < 4; ++i) {
+      if (p[i] == 0) {
+        if (q[i] < 0) return false;  // parallel to this edge and outside it
+        continue;
+      }
+      const double t = q[i] / p[i];
+      if (p[i] < 0) {
+        t0 = std::max(t0, t);
+      } else {
+        t1 = std::min(t1, t);
+      }
+      if (t0 > t1) return false;
+    }
+    xb = xa + t1 * dx;
+    yb = ya + t1 * dy;
+    xa = xa + t0 * dx;
+    ya = ya + t0 * dy;
+    return true;
+  }
+
+  std::uint8_t *data_;
+  int stride_, width_, height_;
+  PixelLayout px_;
+  int r_, g_, b_, a_;
+};
+
+// One arrow at the centre of each spacing × spacing cell, showing the vector of the grid
+// cell under it (nearest), in frame pixels.
+void draw_arrows(GstVideoFrame *frame, const PixelLayout &px, const neuflow::flow::FlowField &field, guint spacing,
+                 guint argb) {
+  const int fw = GST_VIDEO_FRAME_WIDTH(frame);
+  const int fh = GST_VIDEO_FRAME_HEIGHT(frame);
+  const int step = static_cast<int>(spacing);
+  Painter painter(frame, px, argb);
+  for (int y = step / 2; y < fh; y += step) {
+    const int gy = std::min(static_cast<int>((y + 0.5) * field.height / fh), field.height - 1);
+    for (int x = step / 2; x < fw; x += step) {
+      const int gx = std::min(static_cast<int>((x + 0.5) * field.width / fw), field.width - 1);
+      painter.arrow(x, y, field.u(gx, gy), field.v(gx, gy), step);
+    }
+  }
+}
+
+}  // namespace
+
+static void gst_neuflow_viz_set_property(GObject *object, guint prop_id, const GValue *value, GParamSpec *pspec) {
+  GstNeuflowViz *self = GST_NEUFLOW_VIZ(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_MAX_FLOW:
+      self->settings.max_flow = g_value_get_double(value);
+      break;
+    case PROP_MODE:
+      self->settings.mode = static_cast<GstNeuflowVizMode>(g_value_get_enum(value));
+      break;
+    case PROP_ALPHA:
+      self->settings.alpha = g_value_get_double(value);
+      break;
+    case PROP_ARROWS:
+      self->settings.arrows = g_value_get_boolean(value);
+      break;
+    case PROP_ARROW_SPACING:
+      self->settings.arrow_spacing = g_value_get_uint(value);
+      break;
+    case PROP_ARROW_COLOR:
+      self->settings.arrow_color = g_value_get_uint(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_neuflow_viz_get_property(GObject *object, guint prop_id, GValue *value, GParamSpec *pspec) {
+  GstNeuflowViz *self = GST_NEUFLOW_VIZ(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_MAX_FLOW:
+      g_value_set_double(value, self->settings.max_flow);
+      break;
+    case PROP_MODE:
+      g_value_set_enum(value, self->settings.mode);
+      break;
+    case PROP_ALPHA:
+      g_value_set_double(value, self->settings.alpha);
+      break;
+    case PROP_ARROWS:
+      g_value_set_boolean(value, self->settings.arrows);
+      break;
+    case PROP_ARROW_SPACING:
+      g_value_set_uint(value, self->settings.arrow_spacing);
+      break;
+    case PROP_ARROW_COLOR:
+      g_value_set_uint(value, self->settings.arrow_color);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_neuflow_viz_finalize(GObject *object) {
+  GstNeuflowViz *self = GST_NEUFLOW_VIZ(object);
+  delete self->scratch;
+  self->scratch = nullptr;
+  G_OBJECT_CLASS(gst_neuflow_viz_parent_class)->finalize(object);
+}
+
+// The per-format choice: where R, G and B are in a pixel of the negotiated format.
+static gboolean gst_neuflow_viz_set_info(GstVideoFilter *filter, GstCaps * /*incaps*/, GstVideoInfo *in_info,
+                                         GstCaps * /*outcaps*/, GstVideoInfo * /*out_info*/) {
+  GstNeuflowViz *self = GST_NEUFLOW_VIZ(filter);
+  const GstVideoFormatInfo *finfo = in_info->finfo;
+  if (!GST_VIDEO_FORMAT_INFO_IS_RGB(finfo) || GST_VIDEO_FORMAT_INFO_N_PLANES(finfo) != 1 ||
+      GST_VIDEO_FORMAT_INFO_BITS(finfo) != 8) {
+    GST_ERROR_OBJECT(self, "unsupported format %s", GST_VIDEO_FORMAT_INFO_NAME(finfo));
+    return FALSE;
+  }
+  self->layout.r = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_R));
+  self->layout.g = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_G));
+  self->layout.b = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_B));
+  self->layout.stride = GST_VIDEO_INFO_COMP_PSTRIDE(in_info, 0);
+  GST_DEBUG_OBJECT(self, "format %s: R at %d, G at %d, B at %d, %d bytes per pixel",
+                   GST_VIDEO_FORMAT_INFO_NAME(finfo), self->layout.r, self->layout.g, self->layout.b,
+                   self->layout.stride);
+  return TRUE;
+}
+
+// Frames without flow go through untouched: passthrough avoids copying a non-writable buffer
+// that would not be modified anyway.
+static void gst_neuflow_viz_before_transform(GstBaseTransform *trans, GstBuffer *buffer) {
+  const bool has_flow = neuflow_buffer_get_flow_meta(buffer) != nullptr;
+  if ((gst_base_transform_is_passthrough(trans) != FALSE) == has_flow) {
+    GST_LOG_OBJECT(trans, "%s", has_flow ? "flow meta present: drawing" : "no flow meta: passing through");
+    gst_base_transform_set_passthrough(trans, !has_flow);
+  }
+}
+
+static GstFlowReturn gst_neuflow_viz_transform_frame_ip(GstVideoFilter *filter, GstVideoFrame *frame) {
+  GstNeuflowViz *self = GST_NEUFLOW_VIZ(filter);
+  NeuflowFlowMeta *meta = neuflow_buffer_get_flow_meta(frame->buffer);
+  if (!meta || meta->width == 0 || meta->height == 0) return GST_FLOW_OK;
+
+  GST_OBJECT_LOCK(self);
+  const VizSettings settings = self->settings;
+  GST_OBJECT_UNLOCK(self);
+
+  const int fw = GST_VIDEO_FRAME_WIDTH(frame);
+  const int fh = GST_VIDEO_FRAME_HEIGHT(frame);
+  if (meta->frame_width != static_cast<guint>(fw) || meta->frame_height != static_cast<guint>(fh)) {
+    GST_LOG_OBJECT(self, "flow meta covers %ux%u, frame is %dx%d: stretching the grid over the frame",
+                   meta->frame_width, meta->frame_height, fw, fh);
+  }
+
+  try {
+    // The grid with its vectors in pixels of this frame.
+    VizScratch &s = *self->scratch;
+    const int gw = static_cast<int>(meta->width), gh = static_cast<int>(meta->height);
+    if (s.field.width != gw || s.field.height != gh) s.field = neuflow::flow::FlowField(gw, gh);
+    const float sx = static_cast<float>(fw) / static_cast<float>(gw);
+    const float sy = static_cast<float>(fh) / static_cast<float>(gh);
+    const gfloat *vectors = neuflow_flow_meta_get_vectors(meta);
+    for (std::size_t i = 0; i < s.field.pixel_count(); ++i) {
+      s.field.uv[2 * i] = vectors[2 * i] * sx;
+      s.field.uv[2 * i + 1] = vectors[2 * i + 1] * sy;
+    }
+
+    neuflow::flow::VisualizeOptions options;
+    if (settings.max_flow > 0) options.max_flow = settings.max_flow;
+    const neuflow::flow::Visualization vis = neuflow::flow::visualize_flow(s.field, options);
+    GST_LOG_OBJECT(self, "grid %dx%d onto %dx%d, max flow %.2f px", gw, gh, fw, fh, vis.max_flow);
+
+    const int weight = settings.mode == GST_NEUFLOW_VIZ_MODE_FLOW
+                           ? 256
+                           : static_cast<int>(std::lround(std::clamp(settings.alpha, 0.0, 1.0) * 256.0));
+    if (weight > 0) compose_flow(frame, self->layout, vis.image, s, weight);
+    if (settings.arrows) draw_arrows(frame, self->layout, s.field, settings.arrow_spacing, settings.arrow_color);
+  } catch (const std::exception &e) {
+    GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Could not draw the optical flow: %s", e.what()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  return GST_FLOW_OK;
+}
+
+static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
+  GObjectClass *gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass *element_class = GST_ELEMENT_CLASS(klass);
+  GstBaseTransformClass *trans_class = GST_BASE_TRANSFORM_CLASS(klass);
+  GstVideoFilterClass *filter_class = GST_VIDEO_FILTER_CLASS(klass);
+
+  gobject_class->set_property = gst_neuflow_viz_set_property;
+  gobject_class->get_property = gst_neuflow_viz_get_property;
+  gobject_class->finalize = gst_neuflow_viz_finalize;
+
+  constexpr auto rw = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING);
+
+  g_object_class_install_property(
+      gobject_class, PROP_MAX_FLOW,
+      g_param_spec_double("max-flow", "Maximum flow",
+                          "Flow magnitude in pixels of the frame that maps to full colour saturation; longer "
+                          "vectors are drawn saturated and dimmed. A fixed value keeps colours comparable from "
+                          "frame to frame. 0 normalizes every frame by its own largest vector, which makes "
+                          "colours flicker as the motion changes",
+                          0.0, MAX_MAX_FLOW, DEFAULT_MAX_FLOW, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_MODE,
+      g_param_spec_enum("mode", "Mode", "Whether the flow image replaces the video or is blended over it",
+                        GST_TYPE_NEUFLOW_VIZ_MODE, DEFAULT_MODE, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_ALPHA,
+      g_param_spec_double("alpha", "Alpha",
+                          "Opacity of the flow colours in overlay mode (0 = video only, 1 = flow only); "
+                          "ignored in flow mode",
+                          0.0, 1.0, DEFAULT_ALPHA, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_ARROWS,
+      g_param_spec_boolean("arrows", "Arrows",
+                           "Draw a grid of arrows, one per arrow-spacing pixels, each showing the displacement "
+                           "(in frame pixels, true length) at its starting point",
+                           DEFAULT_ARROWS, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_ARROW_SPACING,
+      g_param_spec_uint("arrow-spacing", "Arrow spacing", "Distance in frame pixels between neighbouring arrows",
+                        MIN_ARROW_SPACING, MAX_ARROW_SPACING, DEFAULT_ARROW_SPACING, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_ARROW_COLOR,
+      g_param_spec_uint("arrow-color", "Arrow colour",
+                        "Colour of the arrows as 0xAARRGGBB (AA = opacity; default opaque black)", 0, G_MAXUINT32,
+                        DEFAULT_ARROW_COLOR, rw));
+
+  gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow visualization",
+                                        "Filter/Effect/Video/Analyzer",
+                                        "Draws the optical flow attached to video frames (NeuflowFlowMeta) with the "
+                                        "Middlebury colour wheel, as an image or an overlay, optionally with arrows",
+                                        "neuflow");
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+
+  trans_class->before_transform = GST_DEBUG_FUNCPTR(gst_neuflow_viz_before_transform);
+  trans_class->transform_ip_on_passthrough = FALSE;
+  filter_class->set_info = GST_DEBUG_FUNCPTR(gst_neuflow_viz_set_info);
+  filter_class->transform_frame_ip = GST_DEBUG_FUNCPTR(gst_neuflow_viz_transform_frame_ip);
+
+  gst_type_mark_as_plugin_api(GST_TYPE_NEUFLOW_VIZ_MODE, static_cast<GstPluginAPIFlags>(0));
+}
+
+static void gst_neuflow_viz_init(GstNeuflowViz *self) {
+  self->settings = VizSettings{};
+  self->layout = PixelLayout{};
+  self->scratch = new VizScratch();
+}
