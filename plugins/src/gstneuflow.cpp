@@ -106,6 +106,7 @@ struct Stats {
   guint64 dropped = 0;
   double inference_seconds = 0;  // sum over flows
   double last_inference_seconds = 0;
+  double announced_latency = 0;  // per-frame estimate last announced with a LATENCY message
   std::chrono::steady_clock::time_point started{};
   std::chrono::steady_clock::time_point last_message{};
 };
@@ -312,7 +313,7 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
   st.previous_pts = pts;
   st.previous_frame = frame_number;
 
-  bool post = false;
+  bool post = false, announce = false;
   Stats snapshot;
   {
     const std::lock_guard lock(st.lock);
@@ -321,6 +322,13 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
       ++st.stats.flows;
       st.stats.inference_seconds += seconds;
       st.stats.last_inference_seconds = seconds;
+      // The latency we report follows the measured inference time: tell the pipeline to ask
+      // again when it first appears or grows by more than a fifth.
+      const double mean = st.stats.inference_seconds / static_cast<double>(st.stats.flows);
+      if (mean > 1.2 * st.stats.announced_latency) {
+        st.stats.announced_latency = mean;
+        announce = true;
+      }
     }
     const auto now = std::chrono::steady_clock::now();
     if (settings.stats_interval > 0 &&
@@ -331,6 +339,7 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
     }
   }
   if (post) post_stats(self, snapshot);
+  if (announce) gst_element_post_message(GST_ELEMENT(self), gst_message_new_latency(GST_OBJECT(self)));
   return gst_pad_push(self->srcpad, buffer);
 }
 
@@ -564,7 +573,7 @@ gboolean src_query(GstPad *pad, GstObject *parent, GstQuery *query) {
   double per_frame = 0;
   {
     const std::lock_guard lock(st.lock);
-    per_frame = st.stats.flows ? st.stats.inference_seconds / static_cast<double>(st.stats.flows) : 0.0;
+    per_frame = st.stats.announced_latency;
   }
   // A frame waits at most for the one being computed, then for its own computation.
   const auto ours = static_cast<GstClockTime>(2 * per_frame * GST_SECOND);

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -232,6 +233,79 @@ TEST_F(NeuflowElement, LiveSourceFasterThanInferenceDropsAndKeepsOrder) {
   EXPECT_GT(latency, 0.0);
   gst_object_unref(nf);
   gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
+long resident_kb() {
+  FILE* f = std::fopen("/proc/self/statm", "r");
+  long pages = 0, resident = 0;
+  if (f) {
+    if (std::fscanf(f, "%ld %ld", &pages, &resident) != 2) resident = 0;
+    std::fclose(f);
+  }
+  return resident * 4;
+}
+
+// Over a longer live run the backlog stays within one queued frame, the latency reported in
+// the LATENCY query is bounded and memory does not grow with the number of frames.
+TEST_F(NeuflowElement, LiveRunStaysBoundedInLatencyAndMemory) {
+  GError* err = nullptr;
+  GstElement* pipeline = gst_parse_launch(
+      ("videotestsrc is-live=true pattern=ball ! video/x-raw,width=160,height=120,framerate=60/1 ! neuflow name=nf "
+       "threads=2 iters-s8=4 model=" + model_ + " ! videoscale ! video/x-raw,width=320,height=240 ! fakesink name=sink sync=true")
+          .c_str(),
+      &err);
+  ASSERT_EQ(err, nullptr);
+  GstElement* nf = gst_bin_get_by_name(GST_BIN(pipeline), "nf");
+  GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
+  GstPad* sinkpad = gst_element_get_static_pad(sink, "sink");
+  struct Seen {
+    guint with_meta = 0;
+    guint scaled_frame_width = 0;
+  } seen;
+  gst_pad_add_probe(
+      sinkpad, GST_PAD_PROBE_TYPE_BUFFER,
+      [](GstPad*, GstPadProbeInfo* info, gpointer data) {
+        auto* s = static_cast<Seen*>(data);
+        if (auto* meta = neuflow_buffer_get_flow_meta(GST_PAD_PROBE_INFO_BUFFER(info))) {
+          ++s->with_meta;
+          s->scaled_frame_width = meta->frame_width;
+        }
+        return GST_PAD_PROBE_OK;
+      },
+      &seen, nullptr);
+  ASSERT_NE(gst_element_set_state(pipeline, GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
+  g_usleep(2 * G_USEC_PER_SEC);
+  const long rss_early = resident_kb();
+  guint64 worst_backlog = 0;
+  for (int i = 0; i < 60; ++i) {  // 6 s
+    g_usleep(G_USEC_PER_SEC / 10);
+    const guint64 in = uint64_property(nf, "frames-in"), out = uint64_property(nf, "frames-processed"),
+                  dropped = uint64_property(nf, "frames-dropped");
+    worst_backlog = std::max(worst_backlog, in - out - dropped);
+  }
+  const long rss_late = resident_kb();
+  GstQuery* latency = gst_query_new_latency();
+  ASSERT_TRUE(gst_element_query(pipeline, latency));
+  gboolean live = FALSE;
+  GstClockTime min = 0, max = 0;
+  gst_query_parse_latency(latency, &live, &min, &max);
+  gst_query_unref(latency);
+  double mean_latency_ms = 0;
+  g_object_get(nf, "mean-latency", &mean_latency_ms, nullptr);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+
+  EXPECT_LE(worst_backlog, 2u) << "one frame in the worker and at most one waiting";
+  EXPECT_GT(uint64_property(nf, "frames-dropped"), 0u);
+  EXPECT_TRUE(live);
+  EXPECT_GT(min, 0u) << "the element adds its inference time to the latency";
+  EXPECT_LT(static_cast<double>(min) / GST_MSECOND, 4 * mean_latency_ms + 100) << "latency is bounded";
+  EXPECT_LT(rss_late - rss_early, 20 * 1024) << "memory grew from " << rss_early << " to " << rss_late << " kB";
+  EXPECT_GT(seen.with_meta, 0u) << "flows reach the sink through videoscale";
+  EXPECT_EQ(seen.scaled_frame_width, 320u) << "videoscale keeps the flow and records the new frame size";
+  gst_object_unref(sinkpad);
+  gst_object_unref(sink);
+  gst_object_unref(nf);
   gst_object_unref(pipeline);
 }
 

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Installs the build into a temporary prefix and checks that GStreamer loads the plugin from
+# there (no build tree on any search path). Usage: install_test.sh BUILD_DIR GST_INSPECT
+set -euo pipefail
+build=$1
+inspect=$2
+prefix=$(mktemp -d)
+trap 'rm -rf "$prefix"' EXIT
+cmake --install "$build" --prefix "$prefix" > /dev/null
+plugin=$(find "$prefix" -name libgstneuflow.so | head -n 1)
+[ -n "$plugin" ] || { echo "FAIL: libgstneuflow.so not installed under $prefix"; exit 1; }
+echo "installed: $plugin"
+unset GST_PLUGIN_PATH GST_PLUGIN_PATH_1_0
+GST_PLUGIN_PATH_1_0=$(dirname "$plugin") GST_REGISTRY_1_0="$prefix/registry.bin" "$inspect" neuflow | grep -q "iters-s8" \
+  || { echo "FAIL: gst-inspect-1.0 cannot load the installed plugin"; exit 1; }
+echo "gst-inspect-1.0 loads the installed plugin"
