@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "frame_geometry.hpp"
+#include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "support/fixtures.hpp"
@@ -181,6 +182,20 @@ TEST_F(SessionTest, SessionsOnSeveralThreadsShareOneModel) {
   }
   for (auto& th : threads) th.join();
   for (int t = 0; t < 4; ++t) EXPECT_LT(errors[t], 1e-5) << "thread " << t;
+}
+
+TEST(FlowModelSharing, OneInstancePerCheckpointWhileInUse) {
+  NEUFLOW_REQUIRE_FIXTURE(path, "neuflow-v2-seed0/checkpoint.pth");
+  auto a = FlowModel::load_shared(path);
+  auto b = FlowModel::load_shared(path.parent_path() / "." / path.filename());  // another spelling
+  EXPECT_EQ(a.get(), b.get());
+  const FlowModel* first = a.get();
+  a.reset();
+  b.reset();
+  auto c = FlowModel::load_shared(path);  // released by all users: loaded anew
+  EXPECT_NE(c.get(), nullptr);
+  (void)first;
+  EXPECT_THROW(FlowModel::load_shared(path.parent_path() / "missing.pth"), CheckpointError);
 }
 
 TEST(FrameGeometry, ResizedFlowIsRescaledToInputPixels) {
