@@ -8,7 +8,7 @@ function(neuflow_gst_test_env var registry)
   set(env "GST_PLUGIN_PATH_1_0=$<TARGET_FILE_DIR:gstneuflow>" "GST_REGISTRY_1_0=${registry}")
   if(NEUFLOW_SANITIZE)
     list(APPEND env "GST_REGISTRY_FORK=no"
-         "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/plugins/tests/lsan.supp:print_suppressions=0")
+         "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/plugins/tests/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
   endif()
   set(${var} "${env}" PARENT_SCOPE)
 endfunction()

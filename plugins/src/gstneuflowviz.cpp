@@ -97,11 +97,19 @@ struct VizSettings {
   guint arrow_color = DEFAULT_ARROW_COLOR;
 };
 
-// Where R, G and B sit inside one pixel of the negotiated packed format; chosen once per
-// caps in set_info, so one drawing routine serves every format.
+struct PixelLayout;
+struct VizScratch;
+
+using ComposeFunction = void (*)(GstVideoFrame *frame, const PixelLayout &px, const neuflow::flow::RgbImage &image,
+                                 VizScratch &s, int weight256);
+
+// Where R, G and B sit inside one pixel of the negotiated packed format, and the routines
+// that draw into it; chosen once per caps in set_info.
 struct PixelLayout {
   int r = 0, g = 1, b = 2;
   int stride = 3;  // bytes per pixel
+  ComposeFunction replace = nullptr;  // flow mode
+  ComposeFunction overlay = nullptr;  // overlay mode
 };
 
 // Per-frame scratch kept between frames to avoid reallocating: the grid with vectors in
@@ -110,6 +118,7 @@ struct VizScratch {
   neuflow::flow::FlowField field;
   std::vector<int> x0, x1, wx;  // column -> grid columns and weight of x1 (0..256)
   std::vector<int> y0, y1, wy;  // the same for rows
+  std::vector<int> row;          // one output row's blend of its two grid rows, RGB
 };
 
 }  // namespace
@@ -165,43 +174,52 @@ void bilinear_tables(int n, int m, std::vector<int> &i0, std::vector<int> &i1, s
 }
 
 // Writes the flow colours (grid image stretched bilinearly to the frame) into the frame,
-// replacing it (weight 256) or blending over it.
+// replacing it or blending over it with weight256 / 256. Separable: each output row first
+// blends its two grid rows (into s.row), then each pixel its two columns; in integers, the
+// same sums as a direct bilinear interpolation.
+template <int kPixelStride, bool kReplace>
 void compose_flow(GstVideoFrame *frame, const PixelLayout &px, const neuflow::flow::RgbImage &image, VizScratch &s,
                   int weight256) {
   const int fw = GST_VIDEO_FRAME_WIDTH(frame);
   const int fh = GST_VIDEO_FRAME_HEIGHT(frame);
   auto *data = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0));
   const int stride = GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0);
-  const int gw = image.width;
-  bilinear_tables(fw, gw, s.x0, s.x1, s.wx);
+  const std::size_t row_len = 3 * static_cast<std::size_t>(image.width);
+  bilinear_tables(fw, image.width, s.x0, s.x1, s.wx);
   bilinear_tables(fh, image.height, s.y0, s.y1, s.wy);
+  for (std::size_t x = 0; x < s.x0.size(); ++x) {  // columns as offsets into an RGB row
+    s.x0[x] *= 3;
+    s.x1[x] *= 3;
+  }
+  s.row.resize(row_len);
 
   const std::uint8_t *rgb = image.rgb.data();
+  const int r = px.r, g = px.g, b = px.b;
   for (int y = 0; y < fh; ++y) {
     const auto ky = static_cast<std::size_t>(y);
-    const std::uint8_t *row0 = rgb + 3 * static_cast<std::size_t>(s.y0[ky]) * static_cast<std::size_t>(gw);
-    const std::uint8_t *row1 = rgb + 3 * static_cast<std::size_t>(s.y1[ky]) * static_cast<std::size_t>(gw);
-    const int b = s.wy[ky], a = 256 - b;
+    const std::uint8_t *row0 = rgb + static_cast<std::size_t>(s.y0[ky]) * row_len;
+    const std::uint8_t *row1 = rgb + static_cast<std::size_t>(s.y1[ky]) * row_len;
+    const int wb = s.wy[ky], wa = 256 - wb;
+    int *mixed = s.row.data();
+    for (std::size_t i = 0; i < row_len; ++i) mixed[i] = row0[i] * wa + row1[i] * wb;
+
     std::uint8_t *out = data + static_cast<std::ptrdiff_t>(y) * stride;
-    for (int x = 0; x < fw; ++x, out += px.stride) {
+    for (int x = 0; x < fw; ++x, out += kPixelStride) {
       const auto kx = static_cast<std::size_t>(x);
-      const std::size_t c0 = 3 * static_cast<std::size_t>(s.x0[kx]);
-      const std::size_t c1 = 3 * static_cast<std::size_t>(s.x1[kx]);
-      const int d = s.wx[kx], c = 256 - d;
-      int col[3];
-      for (std::size_t ch = 0; ch < 3; ++ch) {
-        const int top = row0[c0 + ch] * c + row0[c1 + ch] * d;
-        const int bottom = row1[c0 + ch] * c + row1[c1 + ch] * d;
-        col[ch] = (top * a + bottom * b + (1 << 15)) >> 16;
-      }
-      if (weight256 >= 256) {
-        out[px.r] = static_cast<std::uint8_t>(col[0]);
-        out[px.g] = static_cast<std::uint8_t>(col[1]);
-        out[px.b] = static_cast<std::uint8_t>(col[2]);
+      const int *c0 = mixed + s.x0[kx];
+      const int *c1 = mixed + s.x1[kx];
+      const int wd = s.wx[kx], wc = 256 - wd;
+      const int cr = (c0[0] * wc + c1[0] * wd + (1 << 15)) >> 16;
+      const int cg = (c0[1] * wc + c1[1] * wd + (1 << 15)) >> 16;
+      const int cb = (c0[2] * wc + c1[2] * wd + (1 << 15)) >> 16;
+      if constexpr (kReplace) {
+        out[r] = static_cast<std::uint8_t>(cr);
+        out[g] = static_cast<std::uint8_t>(cg);
+        out[b] = static_cast<std::uint8_t>(cb);
       } else {
-        out[px.r] = blend(out[px.r], col[0], weight256);
-        out[px.g] = blend(out[px.g], col[1], weight256);
-        out[px.b] = blend(out[px.b], col[2], weight256);
+        out[r] = blend(out[r], cr, weight256);
+        out[g] = blend(out[g], cg, weight256);
+        out[b] = blend(out[b], cb, weight256);
       }
     }
   }
@@ -401,6 +419,16 @@ static gboolean gst_neuflow_viz_set_info(GstVideoFilter *filter, GstCaps * /*inc
   self->layout.g = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_G));
   self->layout.b = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_B));
   self->layout.stride = GST_VIDEO_INFO_COMP_PSTRIDE(in_info, 0);
+  if (self->layout.stride == 3) {
+    self->layout.replace = compose_flow<3, true>;
+    self->layout.overlay = compose_flow<3, false>;
+  } else if (self->layout.stride == 4) {
+    self->layout.replace = compose_flow<4, true>;
+    self->layout.overlay = compose_flow<4, false>;
+  } else {
+    GST_ERROR_OBJECT(self, "unsupported pixel size %d in %s", self->layout.stride, GST_VIDEO_FORMAT_INFO_NAME(finfo));
+    return FALSE;
+  }
   GST_DEBUG_OBJECT(self, "format %s: R at %d, G at %d, B at %d, %d bytes per pixel",
                    GST_VIDEO_FORMAT_INFO_NAME(finfo), self->layout.r, self->layout.g, self->layout.b,
                    self->layout.stride);
@@ -454,7 +482,11 @@ static GstFlowReturn gst_neuflow_viz_transform_frame_ip(GstVideoFilter *filter, 
     const int weight = settings.mode == GST_NEUFLOW_VIZ_MODE_FLOW
                            ? 256
                            : static_cast<int>(std::lround(std::clamp(settings.alpha, 0.0, 1.0) * 256.0));
-    if (weight > 0) compose_flow(frame, self->layout, vis.image, s, weight);
+    if (weight >= 256) {
+      self->layout.replace(frame, self->layout, vis.image, s, 256);
+    } else if (weight > 0) {
+      self->layout.overlay(frame, self->layout, vis.image, s, weight);
+    }
     if (settings.arrows) draw_arrows(frame, self->layout, s.field, settings.arrow_spacing, settings.arrow_color);
   } catch (const std::exception &e) {
     GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Could not draw the optical flow: %s", e.what()), (nullptr));

@@ -1,0 +1,310 @@
+// neuflowviz on frames with a synthetic NeuflowFlowMeta: known colours of the Middlebury
+// wheel, scaling of a grid smaller than the frame, overlay blending, arrows, passthrough.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "gst_test_util.hpp"
+#include "neuflow/flow/colorwheel.hpp"
+
+namespace neuflow::gst_test {
+namespace {
+
+using flow::flow_color;
+using flow::Rgb8;
+
+HarnessPtr make_viz(GstVideoFormat format, int width, int height) {
+  HarnessPtr h(gst_harness_new("neuflowviz"));
+  gst_harness_set_src_caps_str(h.get(), caps_string(format, width, height).c_str());
+  return h;
+}
+
+// A frame filled with `fill`, carrying a flow grid of uniform (u, v).
+GstBuffer *frame_with_uniform_flow(GstVideoFormat format, int width, int height, std::uint8_t fill, int grid_width,
+                                   int grid_height, float u, float v) {
+  GstBuffer *buffer = make_frame(format, width, height, fill);
+  add_flow(buffer, grid_width, grid_height,
+           make_vectors(grid_width, grid_height, [&](int, int) { return std::pair{u, v}; }), width, height);
+  return buffer;
+}
+
+Rgb8 rgb_at(GstBuffer *buffer, GstVideoFormat format, int width, int height, int x, int y) {
+  GstVideoInfo info;
+  gst_video_info_set_format(&info, format, static_cast<guint>(width), static_cast<guint>(height));
+  const auto px = pixel_bytes(buffer, format, width, height, x, y);
+  return {px.at(static_cast<std::size_t>(GST_VIDEO_INFO_COMP_POFFSET(&info, GST_VIDEO_COMP_R))),
+          px.at(static_cast<std::size_t>(GST_VIDEO_INFO_COMP_POFFSET(&info, GST_VIDEO_COMP_G))),
+          px.at(static_cast<std::size_t>(GST_VIDEO_INFO_COMP_POFFSET(&info, GST_VIDEO_COMP_B)))};
+}
+
+std::string to_string(const Rgb8 &c) {
+  return "(" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " + std::to_string(c[2]) + ")";
+}
+
+// Every pixel of an RGB frame equals `expected`.
+void expect_uniform(GstBuffer *buffer, int width, int height, const Rgb8 &expected) {
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const Rgb8 got = rgb_at(buffer, GST_VIDEO_FORMAT_RGB, width, height, x, y);
+      ASSERT_EQ(got, expected) << "pixel (" << x << ", " << y << "): " << to_string(got) << " instead of "
+                               << to_string(expected);
+    }
+  }
+}
+
+TEST(NeuflowViz, PropertiesHaveTheirDocumentedDefaults) {
+  ElementPtr viz = owned(gst_element_factory_make("neuflowviz", nullptr));
+  ASSERT_TRUE(viz) << "neuflowviz not found: is GST_PLUGIN_PATH the build directory?";
+  gdouble max_flow = 0, alpha = 0;
+  gboolean arrows = TRUE;
+  guint spacing = 0, color = 0;
+  gint mode = -1;
+  g_object_get(viz.get(), "max-flow", &max_flow, "alpha", &alpha, "arrows", &arrows, "arrow-spacing", &spacing,
+               "arrow-color", &color, "mode", &mode, nullptr);
+  EXPECT_EQ(max_flow, 20.0);
+  EXPECT_EQ(alpha, 0.6);
+  EXPECT_FALSE(arrows);
+  EXPECT_EQ(spacing, 24u);
+  EXPECT_EQ(color, 0xff000000u);
+  EXPECT_EQ(mode, 1);  // flow
+  gst_util_set_object_arg(G_OBJECT(viz.get()), "mode", "overlay");
+  g_object_get(viz.get(), "mode", &mode, nullptr);
+  EXPECT_EQ(mode, 0);
+}
+
+TEST(NeuflowViz, ZeroFlowIsWhiteInFlowMode) {
+  constexpr int w = 16, h = 12;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGBA, w, h);
+  BufferPtr out(gst_harness_push_and_pull(harness.get(),
+                                          frame_with_uniform_flow(GST_VIDEO_FORMAT_RGBA, w, h, 77, w, h, 0, 0)));
+  ASSERT_TRUE(out);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const auto px = pixel_bytes(out.get(), GST_VIDEO_FORMAT_RGBA, w, h, x, y);
+      ASSERT_EQ(px, (std::vector<std::uint8_t>{255, 255, 255, 77})) << "pixel (" << x << ", " << y << ")";
+    }
+  }
+}
+
+// Rightward flow at max-flow is the wheel's first colour, pure red, in every format; the
+// alpha or padding byte is left alone.
+struct FormatCase {
+  GstVideoFormat format;
+  std::vector<std::uint8_t> red_pixel;  // bytes of one pixel after drawing (fill 77 elsewhere)
+};
+
+class NeuflowVizFormats : public ::testing::TestWithParam<FormatCase> {};
+
+TEST_P(NeuflowVizFormats, RightwardFlowAtMaxFlowIsTheWheelColourForAngleZero) {
+  const FormatCase &c = GetParam();
+  constexpr int w = 8, h = 6;
+  ASSERT_EQ(flow::colorwheel()[0], (Rgb8{255, 0, 0}));
+  ASSERT_EQ(flow_color(1.0, 0.0), flow::colorwheel()[0]);
+  auto harness = make_viz(c.format, w, h);
+  BufferPtr out(gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(c.format, w, h, 77, w, h, 20, 0)));
+  ASSERT_TRUE(out);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      ASSERT_EQ(pixel_bytes(out.get(), c.format, w, h, x, y), c.red_pixel) << "pixel (" << x << ", " << y << ")";
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    PackedRgb, NeuflowVizFormats,
+    ::testing::Values(FormatCase{GST_VIDEO_FORMAT_RGB, {255, 0, 0}}, FormatCase{GST_VIDEO_FORMAT_BGR, {0, 0, 255}},
+                      FormatCase{GST_VIDEO_FORMAT_RGBA, {255, 0, 0, 77}},
+                      FormatCase{GST_VIDEO_FORMAT_BGRA, {0, 0, 255, 77}},
+                      FormatCase{GST_VIDEO_FORMAT_RGBx, {255, 0, 0, 77}},
+                      FormatCase{GST_VIDEO_FORMAT_BGRx, {0, 0, 255, 77}},
+                      FormatCase{GST_VIDEO_FORMAT_ARGB, {77, 255, 0, 0}},
+                      FormatCase{GST_VIDEO_FORMAT_ABGR, {77, 0, 0, 255}},
+                      FormatCase{GST_VIDEO_FORMAT_xRGB, {77, 255, 0, 0}},
+                      FormatCase{GST_VIDEO_FORMAT_xBGR, {77, 0, 0, 255}}),
+    [](const ::testing::TestParamInfo<FormatCase> &param) {
+      return std::string(gst_video_format_to_string(param.param.format));
+    });
+
+TEST(NeuflowViz, OtherDirectionsGetTheirWheelColours) {
+  constexpr int w = 4, h = 4;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGB, w, h);
+  const std::pair<float, float> directions[] = {{0, 20}, {-20, 0}, {0, -20}, {10, 0}, {40, 0}};
+  for (const auto &[u, v] : directions) {
+    BufferPtr out(
+        gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, u, v)));
+    ASSERT_TRUE(out);
+    SCOPED_TRACE("flow (" + std::to_string(u) + ", " + std::to_string(v) + ")");
+    expect_uniform(out.get(), w, h, flow_color(u / 20.0, v / 20.0));
+  }
+}
+
+TEST(NeuflowViz, FrameWithoutFlowPassesThroughUnchangedAndUncopied) {
+  constexpr int w = 8, h = 6;
+  auto harness = make_viz(GST_VIDEO_FORMAT_BGRx, w, h);
+  for (int round = 0; round < 2; ++round) {
+    // A buffer someone else also holds is not writable: an in-place transform would copy it.
+    GstBuffer *in = make_frame(GST_VIDEO_FORMAT_BGRx, w, h, 77);
+    BufferPtr keep(gst_buffer_ref(in));
+    BufferPtr out(gst_harness_push_and_pull(harness.get(), in));
+    ASSERT_TRUE(out);
+    EXPECT_EQ(out.get(), keep.get()) << "round " << round;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        ASSERT_EQ(pixel_bytes(out.get(), GST_VIDEO_FORMAT_BGRx, w, h, x, y), (std::vector<std::uint8_t>(4, 77)));
+      }
+    }
+    // The next frame has flow again and is drawn.
+    BufferPtr drawn(gst_harness_push_and_pull(harness.get(),
+                                              frame_with_uniform_flow(GST_VIDEO_FORMAT_BGRx, w, h, 77, w, h, 0, 0)));
+    ASSERT_TRUE(drawn);
+    EXPECT_EQ(pixel_bytes(drawn.get(), GST_VIDEO_FORMAT_BGRx, w, h, 3, 3), (std::vector<std::uint8_t>{255, 255, 255, 77}));
+  }
+}
+
+TEST(NeuflowViz, SmallerGridIsStretchedOverTheFrameWithVectorsInFramePixels) {
+  // A 4x3 grid over a 16x12 frame: one grid pixel is 4 frame pixels, so a vector of 5 grid
+  // pixels is 20 frame pixels, i.e. exactly max-flow.
+  constexpr int w = 16, h = 12, gw = 4, gh = 3;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGB, w, h);
+  GstBuffer *in = make_frame(GST_VIDEO_FORMAT_RGB, w, h, 0);
+  add_flow(in, gw, gh, make_vectors(gw, gh, [](int x, int) { return std::pair{x < 2 ? 5.f : -5.f, 0.f}; }), w, h);
+  BufferPtr out(gst_harness_push_and_pull(harness.get(), in));
+  ASSERT_TRUE(out);
+  for (int y = 0; y < h; ++y) {
+    // Columns 0-5 sample only the left half of the grid, 10-15 only the right half.
+    for (int x = 0; x <= 5; ++x) EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, x, y), flow_color(1, 0));
+    for (int x = 10; x < w; ++x) EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, x, y), flow_color(-1, 0));
+  }
+
+  // Vertically: 3 grid pixels over 12 frame rows are 12 frame pixels.
+  g_object_set(harness->element, "max-flow", 12.0, nullptr);
+  BufferPtr down(gst_harness_push_and_pull(harness.get(),
+                                           frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, gw, gh, 0, 3)));
+  ASSERT_TRUE(down);
+  expect_uniform(down.get(), w, h, flow_color(0, 1));
+}
+
+TEST(NeuflowViz, OverlayBlendsTheFlowColoursOverTheVideoWithAlpha) {
+  constexpr int w = 6, h = 4;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGB, w, h);
+  gst_util_set_object_arg(G_OBJECT(harness->element), "mode", "overlay");
+  const std::pair<double, int> cases[] = {{0.5, 178}, {0.0, 100}, {1.0, 255}};  // white over grey 100
+  for (const auto &[alpha, expected] : cases) {
+    g_object_set(harness->element, "alpha", alpha, nullptr);
+    BufferPtr out(gst_harness_push_and_pull(harness.get(),
+                                            frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 100, w, h, 0, 0)));
+    ASSERT_TRUE(out);
+    SCOPED_TRACE("alpha " + std::to_string(alpha));
+    const auto e = static_cast<std::uint8_t>(expected);
+    expect_uniform(out.get(), w, h, Rgb8{e, e, e});
+  }
+}
+
+TEST(NeuflowViz, MaxFlowZeroNormalizesEachFrameByItsLargestVector) {
+  constexpr int w = 4, h = 4;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGB, w, h);
+  BufferPtr fixed(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 3, 0)));
+  ASSERT_TRUE(fixed);
+  expect_uniform(fixed.get(), w, h, flow_color(3.0 / 20.0, 0));
+
+  g_object_set(harness->element, "max-flow", 0.0, nullptr);
+  BufferPtr automatic(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 3, 0)));
+  ASSERT_TRUE(automatic);
+  expect_uniform(automatic.get(), w, h, flow_color(1, 0));
+
+  // A motionless frame stays white rather than dividing by zero.
+  BufferPtr still(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 0, 0)));
+  ASSERT_TRUE(still);
+  expect_uniform(still.get(), w, h, Rgb8{255, 255, 255});
+}
+
+TEST(NeuflowViz, ArrowsStartAtTheGridPointsAndShowTheDisplacement) {
+  constexpr int w = 32, h = 32;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGB, w, h);
+  g_object_set(harness->element, "arrows", TRUE, "arrow-spacing", 16u, nullptr);
+  BufferPtr out(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 6, 0)));
+  ASSERT_TRUE(out);
+  const Rgb8 black{0, 0, 0}, background = flow_color(6.0 / 20.0, 0);
+  // Arrows start at the cell centres (8, 8), (24, 8), (8, 24), (24, 24) and run 6 px right.
+  for (int ay : {8, 24}) {
+    for (int ax : {8, 24}) {
+      for (int x = ax; x <= ax + 6; ++x) EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, x, ay), black);
+      EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, ax - 1, ay), background);  // nothing behind the start
+      if (ax + 8 < w) {
+        EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, ax + 8, ay), background);  // nothing past the tip
+      }
+    }
+  }
+  // Everything else is within the arrow heads' reach of the shafts.
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool near_shaft = (std::abs(y - 8) <= 3 || std::abs(y - 24) <= 3);
+      if (!near_shaft) {
+        ASSERT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, x, y), background) << x << "," << y;
+      }
+    }
+  }
+
+  // A translucent white: blended with the flow colour underneath.
+  g_object_set(harness->element, "arrow-color", 0x80ffffffu, nullptr);
+  BufferPtr translucent(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 6, 0)));
+  ASSERT_TRUE(translucent);
+  Rgb8 expected{};
+  for (std::size_t c = 0; c < 3; ++c) {
+    expected[c] = static_cast<std::uint8_t>((background[c] * (255 - 128) + 255 * 128 + 127) / 255);
+  }
+  EXPECT_EQ(rgb_at(translucent.get(), GST_VIDEO_FORMAT_RGB, w, h, 10, 8), expected);
+}
+
+TEST(NeuflowViz, HugeAndNonFiniteVectorsAreClippedNotFatal) {
+  constexpr int w = 32, h = 24;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGBx, w, h);
+  g_object_set(harness->element, "arrows", TRUE, "arrow-spacing", 4u, nullptr);
+  GstBuffer *in = make_frame(GST_VIDEO_FORMAT_RGBx, w, h, 0);
+  add_flow(in, 4, 3, make_vectors(4, 3, [](int x, int y) {
+             if (x == 0) return std::pair{1e9f, -1e9f};
+             if (x == 1) return std::pair{std::numeric_limits<float>::quiet_NaN(), 0.f};
+             return std::pair{-1e30f * static_cast<float>(y + 1), 3.f};
+           }), w, h);
+  BufferPtr out(gst_harness_push_and_pull(harness.get(), in));
+  ASSERT_TRUE(out);
+}
+
+// The pipeline people will write: negotiation through videoconvert on both sides, and the
+// flow meta surviving a conversion in front of the visualizer.
+TEST(NeuflowViz, NegotiatesThroughVideoconvert) {
+  ElementPtr pipeline = owned(gst_parse_launch(
+      "videotestsrc num-buffers=5 ! video/x-raw,format=I420,width=64,height=48 ! videoconvert ! "
+      "neuflowviz arrows=true ! videoconvert ! fakesink",
+      nullptr));
+  ASSERT_TRUE(pipeline);
+  ASSERT_NE(gst_element_set_state(pipeline.get(), GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
+  BusPtr bus(gst_element_get_bus(pipeline.get()));
+  MessagePtr msg(gst_bus_timed_pop_filtered(bus.get(), 10 * GST_SECOND,
+                                            static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR)));
+  ASSERT_TRUE(msg);
+  EXPECT_EQ(GST_MESSAGE_TYPE(msg.get()), GST_MESSAGE_EOS);
+  gst_element_set_state(pipeline.get(), GST_STATE_NULL);
+}
+
+TEST(NeuflowViz, FlowMetaSurvivesVideoconvertInFront) {
+  constexpr int w = 8, h = 6;
+  HarnessPtr harness(gst_harness_new_parse("videoconvert ! video/x-raw,format=RGBA ! neuflowviz"));
+  gst_harness_set_src_caps_str(harness.get(), caps_string(GST_VIDEO_FORMAT_I420, w, h).c_str());
+  BufferPtr out(gst_harness_push_and_pull(harness.get(),
+                                          frame_with_uniform_flow(GST_VIDEO_FORMAT_I420, w, h, 128, w, h, 20, 0)));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(pixel_bytes(out.get(), GST_VIDEO_FORMAT_RGBA, w, h, 2, 2), (std::vector<std::uint8_t>{255, 0, 0, 255}));
+}
+
+}  // namespace
+}  // namespace neuflow::gst_test
