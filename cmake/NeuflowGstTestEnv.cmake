@@ -1,14 +1,16 @@
 # Environments for tests that load the plugin from the build tree.
-#   neuflow_gst_test_env(<var> <registry-file>) — for our (instrumented) test executables
-#   neuflow_gst_tool_env(<var> <registry-file>) — for GStreamer's own tools (gst-inspect-1.0)
-# Under the sanitizers GStreamer must not fork its (uninstrumented) plugin scanner, the
-# uninstrumented tools get the sanitizer runtimes preloaded, and LSan ignores what GLib and
-# GStreamer keep until exit on purpose (plugins/tests/lsan.supp: their frames only).
-function(neuflow_gst_test_env var registry)
-  set(env "GST_PLUGIN_PATH_1_0=$<TARGET_FILE_DIR:gstneuflow>" "GST_REGISTRY_1_0=${registry}")
+#   neuflow_gst_test_env(<var>) — for our (instrumented) gtest executables, whose main()
+#     (plugins/tests/gst_test_main.cpp) sets the plugin path and registry itself: under the
+#     sanitizers, LSan ignores what GLib keeps until exit on purpose (plugins/tests/lsan.supp,
+#     their frames only; GLib has no frame pointers, hence the slow unwinder). One variable,
+#     since gtest_discover_tests splits lists.
+#   neuflow_gst_tool_env(<var> <registry-file>) — for GStreamer's own tools (gst-inspect-1.0):
+#     the plugin path and registry, and under the sanitizers their runtimes preloaded, as
+#     the tools are not instrumented.
+function(neuflow_gst_test_env var)
+  set(env "")
   if(NEUFLOW_SANITIZE)
-    list(APPEND env "GST_REGISTRY_FORK=no"
-         "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/plugins/tests/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
+    set(env "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/plugins/tests/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
   endif()
   set(${var} "${env}" PARENT_SCOPE)
 endfunction()

@@ -11,6 +11,10 @@ plugin=$(find "$prefix" -name libgstneuflow.so | head -n 1)
 [ -n "$plugin" ] || { echo "FAIL: libgstneuflow.so not installed under $prefix"; exit 1; }
 echo "installed: $plugin"
 unset GST_PLUGIN_PATH GST_PLUGIN_PATH_1_0
-GST_PLUGIN_PATH_1_0=$(dirname "$plugin") GST_REGISTRY_1_0="$prefix/registry.bin" "$inspect" neuflow | grep -q "iters-s8" \
-  || { echo "FAIL: gst-inspect-1.0 cannot load the installed plugin"; exit 1; }
+if ! output=$(GST_PLUGIN_PATH_1_0=$(dirname "$plugin") GST_REGISTRY_1_0="$prefix/registry.bin" "$inspect" neuflow 2>&1) \
+    || ! grep -q "iters-s8" <<<"$output"; then
+  echo "FAIL: gst-inspect-1.0 cannot load the installed plugin:"
+  echo "$output" | head -n 20
+  exit 1
+fi
 echo "gst-inspect-1.0 loads the installed plugin"

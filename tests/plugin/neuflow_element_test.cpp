@@ -20,12 +20,6 @@
 
 namespace {
 
-class GstEnvironment : public ::testing::Environment {
- public:
-  void SetUp() override { gst_init(nullptr, nullptr); }
-};
-const auto* const gst_environment = ::testing::AddGlobalTestEnvironment(new GstEnvironment);
-
 GstBuffer* rgb_buffer(const cv::Mat& rgb, GstClockTime pts) {
   const gsize size = rgb.total() * rgb.elemSize();
   GstBuffer* buf = gst_buffer_new_allocate(nullptr, size, nullptr);
@@ -300,7 +294,14 @@ TEST_F(NeuflowElement, LiveRunStaysBoundedInLatencyAndMemory) {
   EXPECT_TRUE(live);
   EXPECT_GT(min, 0u) << "the element adds its inference time to the latency";
   EXPECT_LT(static_cast<double>(min) / GST_MSECOND, 4 * mean_latency_ms + 100) << "latency is bounded";
+#if defined(__SANITIZE_ADDRESS__)
+  // ASan keeps freed memory in quarantine, so resident size says nothing about leaks here;
+  // LeakSanitizer checks those at exit instead.
+  (void)rss_early;
+  (void)rss_late;
+#else
   EXPECT_LT(rss_late - rss_early, 20 * 1024) << "memory grew from " << rss_early << " to " << rss_late << " kB";
+#endif
   EXPECT_GT(seen.with_meta, 0u) << "flows reach the sink through videoscale";
   EXPECT_EQ(seen.scaled_frame_width, 320u) << "videoscale keeps the flow and records the new frame size";
   gst_object_unref(sinkpad);
@@ -327,7 +328,6 @@ TEST_F(NeuflowElement, SurvivesManyStateCycles) {
 }
 
 TEST(NeuflowElementErrors, AMissingModelFailsTheStateChangeNamingTheFile) {
-  gst_init(nullptr, nullptr);
   ASSERT_NE(gst_element_factory_find("neuflow"), nullptr) << "plugin not found: is GST_PLUGIN_PATH set?";
   GError* err = nullptr;
   GstElement* pipeline =
