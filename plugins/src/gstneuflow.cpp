@@ -450,23 +450,24 @@ GstFlowReturn sink_chain(GstPad * /*pad*/, GstObject *parent, GstBuffer *buffer)
     gst_buffer_unref(buffer);
     return st.downstream;
   }
+  std::vector<GstBuffer *> dropped;
+  guint64 processed = 0, drops = 0;
+  GstSegment segment{};
   if (*live) {
-    // Newest wins: a frame still waiting for the worker is replaced by this one.
+    // Newest wins: a frame still waiting for the worker is replaced by this one. The QoS
+    // messages are posted after unlocking, from what was collected here.
     for (auto it = st.queue.begin(); it != st.queue.end();) {
       if (it->buffer) {
-        ++st.stats.dropped;
-        GstBuffer *old = it->buffer;
-        const guint64 processed = st.stats.processed, drops = st.stats.dropped;
-        const GstSegment segment = st.segment;
+        dropped.push_back(it->buffer);
         it = st.queue.erase(it);
-        lock.unlock();
-        post_drop(self, old, segment, processed, drops);
-        gst_buffer_unref(old);
-        lock.lock();
       } else {
         ++it;
       }
     }
+    st.stats.dropped += dropped.size();
+    processed = st.stats.processed;
+    drops = st.stats.dropped;
+    segment = st.segment;
   } else {
     st.cond.wait(lock, [&] {
       std::size_t buffers = 0;
@@ -481,6 +482,10 @@ GstFlowReturn sink_chain(GstPad * /*pad*/, GstObject *parent, GstBuffer *buffer)
   st.queue.push_back(Item{buffer, nullptr, frame});
   lock.unlock();
   st.cond.notify_all();
+  for (GstBuffer *old : dropped) {
+    post_drop(self, old, segment, processed, drops);
+    gst_buffer_unref(old);
+  }
   return GST_FLOW_OK;
 }
 
