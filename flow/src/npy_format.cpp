@@ -186,7 +186,7 @@ void mark_non_finite_pixels(FlowField& field) {
 
 }  // namespace
 
-FlowField read_npy(const std::filesystem::path& path) {
+NpyArray read_npy_array(const std::filesystem::path& path, const NpyShapeCheck& check_shape) {
   detail::BinaryInput in(path);
   std::array<std::byte, 12> prefix{};
   if (in.size() < 10) {
@@ -232,42 +232,60 @@ FlowField read_npy(const std::filesystem::path& path) {
   if (descr != "<f4") {
     throw FlowFileError(Kind::malformed, path,
                         "dtype " + describe_dtype(descr) +
-                            " is not supported; a flow .npy must be little-endian float32 "
-                            "('<f4'), e.g. np.save(path, flow.astype(np.float32))");
+                            " is not supported; expected little-endian float32 ('<f4'), e.g. "
+                            "np.save(path, array.astype(np.float32))");
   }
-  if (shape.size() != 3 || shape[2] != 2) {
-    throw FlowFileError(Kind::malformed, path,
-                        "array shape " + shape_text(shape) +
-                            " is not a flow field; expected (H, W, 2) with u, v last");
-  }
+  if (check_shape) check_shape(shape);
   if (fortran) {
     throw FlowFileError(Kind::malformed, path,
                         "Fortran-order arrays are not supported; save "
-                        "np.ascontiguousarray(flow) instead");
+                        "np.ascontiguousarray(array) instead");
   }
-  const std::int64_t height = shape[0];
-  const std::int64_t width = shape[1];
-  if (!flow_size_acceptable(width, height)) {
-    throw FlowFileError(Kind::malformed, path,
-                        "implausible flow size " + std::to_string(width) + "x" +
-                            std::to_string(height) + " (accepted: 1.." +
-                            std::to_string(kMaxFlowSide) + " per side, at most " +
-                            std::to_string(kMaxFlowPixels) + " pixels)");
+  // The element count, bounded by what the file can hold, before anything is allocated.
+  const std::uint64_t data_bytes = in.size() - prefix_len - header_len;
+  std::uint64_t count = 1;
+  bool too_large = false;
+  for (const std::int64_t d : shape) {
+    if (d < 0 || (d > 0 && count > (data_bytes / 4 + 1) / static_cast<std::uint64_t>(d))) too_large = true;
+    count *= static_cast<std::uint64_t>(d < 0 ? 0 : d);
   }
-  const std::uint64_t expected =
-      prefix_len + header_len + 8 * static_cast<std::uint64_t>(width * height);
-  if (in.size() != expected) {
+  if (too_large || 4 * count != data_bytes) {
+    const bool truncated = too_large || 4 * count > data_bytes;
     throw FlowFileError(Kind::malformed, path,
-                        std::string(in.size() < expected ? "truncated" : "trailing data") +
-                            ": shape " + shape_text(shape) + " needs " + std::to_string(expected) +
-                            " bytes, but the file is " + std::to_string(in.size()) + " bytes");
+                        std::string(truncated ? "truncated" : "trailing data") + ": shape " +
+                            shape_text(shape) + " needs " +
+                            (too_large ? std::string("more bytes than the file has")
+                                       : std::to_string(prefix_len + header_len + 4 * count) + " bytes") +
+                            ", but the file is " + std::to_string(in.size()) + " bytes");
   }
 
-  FlowField field(static_cast<int>(width), static_cast<int>(height));
-  in.read(std::as_writable_bytes(std::span(field.uv)), "array data");
+  NpyArray array{shape, std::vector<float>(count)};
+  in.read(std::as_writable_bytes(std::span(array.data)), "array data");
   if constexpr (std::endian::native == std::endian::big) {
-    for (float& x : field.uv) x = detail::load_le_f32(reinterpret_cast<const std::byte*>(&x));
+    for (float& x : array.data) x = detail::load_le_f32(reinterpret_cast<const std::byte*>(&x));
   }
+  return array;
+}
+
+FlowField read_npy(const std::filesystem::path& path) {
+  NpyArray array = read_npy_array(path, [&](const Shape& shape) {
+    if (shape.size() != 3 || shape[2] != 2) {
+      throw FlowFileError(Kind::malformed, path,
+                          "array shape " + shape_text(shape) +
+                              " is not a flow field; expected (H, W, 2) with u, v last");
+    }
+    if (!flow_size_acceptable(shape[1], shape[0])) {
+      throw FlowFileError(Kind::malformed, path,
+                          "implausible flow size " + std::to_string(shape[1]) + "x" +
+                              std::to_string(shape[0]) + " (accepted: 1.." +
+                              std::to_string(kMaxFlowSide) + " per side, at most " +
+                              std::to_string(kMaxFlowPixels) + " pixels)");
+    }
+  });
+  FlowField field;
+  field.height = static_cast<int>(array.shape[0]);
+  field.width = static_cast<int>(array.shape[1]);
+  field.uv = std::move(array.data);
   mark_non_finite_pixels(field);
   return field;
 }

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <stdexcept>
+
 #include <sys/wait.h>
 
 #include <cmath>
@@ -271,6 +274,35 @@ np.save(os.path.join(d, 'fortran.npy'), np.asfortranarray(a))
                     "array shape (2, 5, 7)");
   expect_flow_error([&] { read_npy(dir_ / "fortran.npy"); }, Kind::malformed,
                     dir_ / "fortran.npy", "Fortran-order");
+}
+
+TEST(NpyArray, ReadsAnyRankAndChecksTheShapeBeforeTheData) {
+  test::TempDir dir;
+  std::vector<std::uint8_t> data(24);
+  for (int i = 0; i < 6; ++i) {
+    const float v = 0.5f * static_cast<float>(i);
+    std::memcpy(data.data() + 4 * i, &v, 4);
+  }
+  auto bytes = npy_bytes(f4_dict("(2, 3)"), 0);
+  bytes.insert(bytes.end(), data.begin(), data.end());
+  test::write_bytes(dir / "a.npy", bytes);
+  const NpyArray a = read_npy_array(dir / "a.npy");
+  EXPECT_EQ(a.shape, (std::vector<std::int64_t>{2, 3}));
+  ASSERT_EQ(a.data.size(), 6u);
+  EXPECT_EQ(a.data[5], 2.5f);
+
+  // A truncated file is refused by the check first, with the check's own error.
+  test::write_bytes(dir / "t.npy", npy_bytes(f4_dict("(1, 2, 3, 4)"), 8));
+  bool checked = false;
+  EXPECT_THROW(read_npy_array(dir / "t.npy",
+                              [&](const std::vector<std::int64_t>& shape) {
+                                checked = true;
+                                EXPECT_EQ(shape.size(), 4u);
+                                throw std::invalid_argument("refused");
+                              }),
+               std::invalid_argument);
+  EXPECT_TRUE(checked);
+  expect_flow_error([&] { read_npy_array(dir / "t.npy"); }, Kind::malformed, dir / "t.npy", "truncated");
 }
 
 }  // namespace

@@ -12,7 +12,7 @@
 
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
-#include "npy_array.hpp"
+#include "neuflow/flow/npy_format.hpp"
 #include "support/fixtures.hpp"
 
 namespace neuflow::model {
@@ -61,7 +61,7 @@ TEST(NetworkReference, EveryStageMatchesTheReference) {
 
   int compared = 0;
   for (const auto& [name, magnitude] : absmax) {
-    const auto ref = neuflow::test::read_npy_array(dir / (name + ".npy"));
+    const auto ref = neuflow::flow::read_npy_array(dir / (name + ".npy"));
     ASSERT_EQ(ref.shape.size(), 4u) << name;
     const int n = static_cast<int>(ref.shape[0]), c = static_cast<int>(ref.shape[1]);
     const int h = static_cast<int>(ref.shape[2]), w = static_cast<int>(ref.shape[3]);
@@ -102,7 +102,7 @@ TEST(NetworkReference, EveryStageMatchesTheReference) {
   EXPECT_EQ(compared, 32);
 
   // The returned field is the final flow, interleaved, at the frame's size.
-  const auto ref = neuflow::test::read_npy_array(dir / "flow.npy");
+  const auto ref = neuflow::flow::read_npy_array(dir / "flow.npy");
   ASSERT_EQ(result.width, 320);
   ASSERT_EQ(result.height, 256);
   double max_err = 0;

@@ -11,7 +11,10 @@
 //
 // Writing produces version 1.0 with the header padded to a multiple of 64 bytes, as numpy
 // does. .npy has no mask, so invalid pixels are written as NaN, which reads back invalid.
+#include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <vector>
 
 #include "neuflow/flow/flow_field.hpp"
 
@@ -19,6 +22,17 @@ namespace neuflow::flow {
 
 // Throws FlowFileError.
 FlowField read_npy(const std::filesystem::path& path);
+
+// Any little-endian float32, C-order array (what the reference tools dump as tensors).
+struct NpyArray {
+  std::vector<std::int64_t> shape;
+  std::vector<float> data;  // product(shape) values, C order
+};
+// Called with the shape before any data is read or allocated; throws to refuse it.
+using NpyShapeCheck = std::function<void(const std::vector<std::int64_t>& shape)>;
+// Same header rules and errors as read_npy, without the (H, W, 2) requirement. The data size
+// must match the file size exactly, so a header cannot make it allocate more than the file.
+NpyArray read_npy_array(const std::filesystem::path& path, const NpyShapeCheck& check_shape = {});
 // Atomic. Throws FlowFileError, or std::invalid_argument for an inconsistent field.
 void write_npy(const FlowField& field, const std::filesystem::path& path);
 
