@@ -24,6 +24,7 @@
 #include <gst/video/video.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <deque>
 #include <memory>
@@ -106,7 +107,8 @@ struct Stats {
   guint64 dropped = 0;
   double inference_seconds = 0;  // sum over flows
   double last_inference_seconds = 0;
-  double announced_latency = 0;  // per-frame estimate last announced with a LATENCY message
+  double latency_estimate = 0;   // moving average of recent inference times
+  double announced_latency = 0;  // the estimate last announced with a LATENCY message
   std::chrono::steady_clock::time_point started{};
   std::chrono::steady_clock::time_point last_message{};
 };
@@ -322,11 +324,14 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
       ++st.stats.flows;
       st.stats.inference_seconds += seconds;
       st.stats.last_inference_seconds = seconds;
-      // The latency we report follows the measured inference time: tell the pipeline to ask
-      // again when it first appears or grows by more than a fifth.
-      const double mean = st.stats.inference_seconds / static_cast<double>(st.stats.flows);
-      if (mean > 1.2 * st.stats.announced_latency) {
-        st.stats.announced_latency = mean;
+      // The latency we report follows recent inference times (the first flows pay for
+      // warm-up); the pipeline is told to ask again when the estimate first appears or moves
+      // by more than a fifth either way.
+      double& estimate = st.stats.latency_estimate;
+      estimate = estimate == 0 ? seconds : 0.75 * estimate + 0.25 * seconds;
+      const double announced = st.stats.announced_latency;
+      if (announced == 0 || std::abs(estimate - announced) > 0.2 * announced) {
+        st.stats.announced_latency = estimate;
         announce = true;
       }
     }
