@@ -16,7 +16,8 @@ struct FlowSession::State {
   FrameGeometry geometry;
   std::unique_ptr<NetworkPlan> plan;
   Tensor input, model_flow;
-  FrameFeatures previous, current, pair_second;
+  FrameFeatures previous, current;   // the stream
+  FrameFeatures pair_first, pair_second;  // compute(), kept apart from the stream
   bool has_previous = false;
   StageObserver observer;
 };
@@ -80,12 +81,11 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   apply_threads(options_.threads);
   auto& s = *state_;
   const FrameGeometry& g = prepare_plan(s, model_->weights(), options_, frame0.width, frame0.height);
-  FrameFeatures first;
   prepare_input(frame0, g, s.input);
-  s.plan->encode(s.stream, s.input, first);
+  s.plan->encode(s.stream, s.input, s.pair_first);
   prepare_input(frame1, g, s.input);
   s.plan->encode(s.stream, s.input, s.pair_second);
-  s.plan->flow(s.stream, first, s.pair_second, iterations.s16, iterations.s8, s.model_flow, &s.observer);
+  s.plan->flow(s.stream, s.pair_first, s.pair_second, iterations.s16, iterations.s8, s.model_flow, &s.observer);
   return restore_flow(s.model_flow, g);
 }
 
