@@ -11,6 +11,17 @@ packages=(
   libcli11-dev                      # command-line parsing
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer plugin
   gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-tools
+  gstreamer1.0-plugins-bad          # intervideo (RTSP mounts), h264parse
+  gstreamer1.0-plugins-ugly         # x264enc: the encoded visualization
+  gstreamer1.0-libav                # decoders for common video files (e.g. vtest.avi's MS-MPEG4)
+  gstreamer1.0-rtsp libgstrtspserver-1.0-dev   # neuflowd's RTSP server mounts
+  gstreamer1.0-libcamera            # libcamerasrc: CSI cameras
+  libsystemd-dev                    # sd_notify: READY/WATCHDOG/STATUS
+  libtomlplusplus-dev               # neuflowd's config file
+  libsoup-3.0-dev                   # neuflowd's Prometheus metrics endpoint
+  libcurl4-openssl-dev libssl-dev   # neuflow fetch-model: download + SHA-1 verification
+  opencv-doc                        # sample video (vtest.avi) for the quick-start job
+  systemd                           # systemd-analyze verify of the unit files
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-numpy             # tests check that numpy reads our .npy files
 )

@@ -39,5 +39,8 @@ void register_viz(CLI::App& app);
 void register_compare(CLI::App& app);
 void register_inspect(CLI::App& app);
 void register_flow(CLI::App& app);
+void register_convert(CLI::App& app);
+void register_eval(CLI::App& app);
+void register_fetch_model(CLI::App& app);
 
 }  // namespace neuflow::cli

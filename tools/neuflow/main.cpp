@@ -16,6 +16,9 @@ int main(int argc, char** argv) {
   neuflow::cli::register_compare(app);
   neuflow::cli::register_inspect(app);
   neuflow::cli::register_flow(app);
+  neuflow::cli::register_convert(app);
+  neuflow::cli::register_eval(app);
+  neuflow::cli::register_fetch_model(app);
 
   try {
     app.parse(argc, argv);

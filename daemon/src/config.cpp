@@ -1,0 +1,2 @@
+// Placeholder: the config loader is being written.
+#include "config.hpp"

@@ -1,0 +1,2 @@
+// Placeholder: neuflowd's entry point is being written.
+int main() { return 0; }
