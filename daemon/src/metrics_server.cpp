@@ -1,0 +1,1 @@
+// Placeholder: the metrics endpoint is being written.
