@@ -1,2 +1,68 @@
-// Placeholder: neuflowd's entry point is being written.
-int main() { return 0; }
+// neuflowd: runs the capture → flow → sink streams of one config file until stopped.
+//   neuflowd --config /etc/neuflow/neuflowd.toml    run (under systemd: Type=notify)
+//   neuflowd --check-config FILE                    validate and exit
+#include <gst/gst.h>
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "config.hpp"
+#include "daemon.hpp"
+#include "log.hpp"
+
+namespace {
+
+constexpr int kExitConfig = 78;  // EX_CONFIG: the unit's RestartPreventExitStatus
+
+void print_issues(const neuflow::daemon::ConfigError& e) {
+  for (const auto& issue : e.issues()) std::fprintf(stderr, "%s\n", issue.to_string().c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"neuflowd: NeuFlow-V2 optical flow streams (cameras, files, network) to files, shared memory and video"};
+  app.set_version_flag("--version", std::string("neuflowd ") + NEUFLOW_VERSION);
+  std::string config_file = "/etc/neuflow/neuflowd.toml";
+  std::string check_file;
+  std::string level;
+  app.add_option("-c,--config", config_file, "Config file to run")->capture_default_str();
+  app.add_option("--check-config", check_file,
+                 "Check FILE (syntax, keys, types, referenced files, devices and GStreamer elements) and exit: 0 "
+                 "when it is valid, 78 with one line per problem otherwise");
+  app.add_option("--log-level", level, "error, warning, notice, info or debug; overrides [daemon] log-level");
+  CLI11_PARSE(app, argc, argv);
+
+  using namespace neuflow::daemon;
+  use_log_prefix_from_environment();
+  gst_init(nullptr, nullptr);
+
+  if (!check_file.empty()) {
+    try {
+      const Config config = load_config(check_file);
+      std::printf("%s: OK, %zu stream%s\n", check_file.c_str(), config.streams.size(),
+                  config.streams.size() == 1 ? "" : "s");
+      return 0;
+    } catch (const ConfigError& e) {
+      print_issues(e);
+      return kExitConfig;
+    }
+  }
+
+  try {
+    Config config = load_config(config_file);
+    if (!level.empty()) config.daemon.log_level = level;
+    set_log_level(parse_log_level(config.daemon.log_level));
+    Daemon daemon(std::move(config));
+    return daemon.run();
+  } catch (const ConfigError& e) {
+    print_issues(e);
+    return kExitConfig;
+  } catch (const std::exception& e) {
+    log_error(e.what());
+    return 1;
+  }
+}

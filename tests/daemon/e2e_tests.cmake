@@ -1,1 +1,35 @@
-# Filled in by the work on neuflowd (e2e).
+# neuflowd as a real process: READY/RELOADING/WATCHDOG through a notify socket the test owns,
+# flows read from the files sink and from the shared-memory ring by a separate reader process,
+# SIGHUP with a changed config, SIGTERM → exit 0 and a playable MP4, a failing source restarted
+# while another stream keeps producing, a failing sink cut off, config errors with line numbers.
+find_program(NEUFLOW_E2E_PYTHON NAMES python3 HINTS /usr/bin NO_DEFAULT_PATH)
+find_program(GST_LAUNCH gst-launch-1.0 REQUIRED)
+include(NeuflowGstTestEnv)
+neuflow_gst_test_env(e2e_sanitizer_env)   # neuflowd itself is instrumented under NEUFLOW_SANITIZE
+
+if(TARGET neuflow-shm-reader)
+  set(shm_reader "$<TARGET_FILE:neuflow-shm-reader>")
+else()
+  set(shm_reader "neuflow-shm-reader-not-built")
+endif()
+set(e2e_env
+  "NEUFLOWD=$<TARGET_FILE:neuflowd>"
+  "NEUFLOW_SHM_READER=${shm_reader}"
+  "GST_LAUNCH=${GST_LAUNCH}"
+  "GST_PLUGIN_PATH_1_0=$<TARGET_FILE_DIR:gstneuflow>"
+  "GST_REGISTRY_1_0=${CMAKE_CURRENT_BINARY_DIR}/e2e-registry.bin"
+  ${e2e_sanitizer_env})
+
+foreach(test_case
+    DaemonLifecycle.test_ready_flows_reload_and_clean_stop
+    DaemonLifecycle.test_watchdog_and_status
+    DaemonFailures.test_failing_source_restarts_while_other_stream_runs
+    DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
+    CheckConfig.test_valid_config_passes
+    CheckConfig.test_errors_name_line_and_exit_78
+    CheckConfig.test_missing_model_is_reported_at_start_too)
+  add_test(NAME daemon.e2e.${test_case}
+           COMMAND ${NEUFLOW_E2E_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/e2e_test.py -v ${test_case})
+  set_tests_properties(daemon.e2e.${test_case} PROPERTIES LABELS "daemon;e2e" ENVIRONMENT "${e2e_env}"
+                       TIMEOUT 300 RESOURCE_LOCK neuflowd_e2e)
+endforeach()

@@ -1,0 +1,109 @@
+#pragma once
+// One configured stream, supervised: it builds its pipeline, watches the bus, restarts the
+// pipeline with exponential backoff when the source or the flow element fails (or stops
+// delivering frames), cuts off a failing sink while others remain, and stops cleanly with
+// EOS so files are finalized. Everything here runs on the daemon's main loop (main thread);
+// GStreamer's threads only ever touch the graph's sink-failure marks.
+#include <gst/gst.h>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "config.hpp"
+#include "stream_graph.hpp"
+
+namespace neuflow::daemon {
+
+enum class StreamState { idle, starting, playing, backoff, stopping, stopped, finished };
+const char* to_string(StreamState state);
+
+struct StreamSnapshot {
+  std::string name;
+  StreamState state = StreamState::idle;
+  std::uint64_t frames_in = 0;         // over all runs of the pipeline
+  std::uint64_t frames_processed = 0;
+  std::uint64_t frames_dropped = 0;
+  std::uint64_t flows = 0;             // frames that left with a flow
+  double latency_ms = 0;               // mean inference time of the current run
+  double rate_fps = 0;                 // frames leaving the flow element per second, recently
+  std::uint64_t restarts = 0;
+  std::uint64_t sink_failures = 0;
+  double seconds_in_state = 0;
+  double retry_in_s = 0;               // backoff only
+};
+
+class Stream {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  // `threads`: inference threads for this stream's flow element.
+  Stream(StreamConfig config, int threads, DaemonSettings settings);
+  ~Stream();
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+
+  void start();
+  // Ends the stream with EOS (bounded by stop-timeout), then calls `done` on the main loop.
+  void stop(std::function<void()> done);
+  // Once a second: reads the counters, restarts a stalled stream.
+  void tick();
+
+  const std::string& name() const { return config_.name; }
+  const StreamConfig& config() const { return config_; }
+  int threads() const { return threads_; }
+  StreamState state() const { return state_; }
+  // True once the first start has settled: playing, failed or finished (for READY=1).
+  bool settled() const { return settled_; }
+  // Whether the supervisor is in control (for WATCHDOG=1): false when a state change has
+  // taken far longer than it may.
+  bool healthy() const;
+  StreamSnapshot snapshot() const;
+  std::string status() const;  // short, for STATUS=
+
+ private:
+  static gboolean on_bus_message(GstBus*, GstMessage* message, gpointer self);
+  static GstBusSyncReply on_bus_sync(GstBus*, GstMessage* message, gpointer graph);
+  static gboolean on_restart_timer(gpointer self);
+  static gboolean on_stop_timeout(gpointer self);
+
+  void handle_message(GstMessage* message);
+  void fail(const std::string& reason);
+  void teardown();
+  void finish_stop();
+  void enter(StreamState state);
+  void read_counters();
+
+  StreamConfig config_;
+  int threads_;
+  DaemonSettings settings_;
+  std::unique_ptr<StreamGraph> graph_;
+  guint bus_watch_ = 0;
+  guint restart_timer_ = 0;
+  guint stop_timer_ = 0;
+  std::function<void()> stop_done_;
+
+  StreamState state_ = StreamState::idle;
+  Clock::time_point state_since_ = Clock::now();
+  Clock::time_point restart_at_{};
+  Clock::time_point last_progress_{};
+  double backoff_s_ = 0;
+  bool settled_ = false;
+  int run_ = 0;  // pipeline instances started, for names in GStreamer's logs
+
+  // Counters: `base_` holds what finished runs counted, `current_` the running pipeline's.
+  struct Counters {
+    std::uint64_t in = 0, processed = 0, dropped = 0, flows = 0;
+  } base_, current_;
+  double latency_ms_ = 0;
+  double rate_fps_ = 0;
+  std::uint64_t last_processed_ = 0;  // for stall detection
+  std::uint64_t rate_base_ = 0;       // processed count at the last rate measurement
+  Clock::time_point last_rate_at_{};
+  std::uint64_t restarts_ = 0;
+  std::uint64_t sink_failures_ = 0;
+};
+
+}  // namespace neuflow::daemon

@@ -1,0 +1,72 @@
+#pragma once
+// One stream's GStreamer pipeline, built from its config:
+//
+//   source → videoconvert → neuflow → tee ─┬→ queue → <sink branch 0>
+//                                           └→ queue → <sink branch 1> …
+//
+// Each sink branch is a bin of its own so that an error inside it can be told apart from an
+// error of the source or the flow element, and the branch cut off without stopping the rest:
+// a probe on its tee pad drops everything once the branch is marked failed (the mark is set
+// from the bus's sync handler, in the thread that posted the error, before the failing
+// element returns its flow error upstream).
+#include <gst/gst.h>
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "config.hpp"
+
+namespace neuflow::daemon {
+
+struct SinkBranch {
+  std::string name;               // SinkConfig::name
+  std::string kind;               // "files", "shm", "video", "display"
+  GstElement* bin = nullptr;      // our reference; in the pipeline until removed
+  GstPad* tee_pad = nullptr;      // our reference to the tee's request pad
+  std::atomic<bool> failed{false};
+  bool removed = false;           // taken out of the pipeline after failing (main thread only)
+};
+
+// Owns the pipeline (one reference) and the tee pads.
+class StreamGraph {
+ public:
+  StreamGraph() = default;
+  ~StreamGraph();
+  StreamGraph(const StreamGraph&) = delete;
+  StreamGraph& operator=(const StreamGraph&) = delete;
+
+  GstElement* pipeline() const { return pipeline_; }
+  GstElement* flow_element() const { return flow_; }
+  std::vector<std::unique_ptr<SinkBranch>>& sinks() { return sinks_; }
+
+  // The branch an element belongs to, or nullptr when it is outside every sink branch.
+  SinkBranch* branch_of(GstObject* element);
+
+  // Takes a failed branch out of the running pipeline (main thread).
+  void remove_branch(SinkBranch& branch);
+
+  size_t live_branches() const;
+
+ private:
+  friend std::unique_ptr<StreamGraph> build_stream_graph(const StreamConfig&, int, const std::string&);
+  GstElement* pipeline_ = nullptr;
+  GstElement* flow_ = nullptr;
+  GstElement* tee_ = nullptr;
+  std::vector<std::unique_ptr<SinkBranch>> sinks_;
+};
+
+// The intervideo channel that carries a stream's visualization to an RTSP mount.
+std::string rtsp_channel_name(const std::string& stream, const std::string& mount);
+
+// Builds the pipeline in NULL state. `threads` is the inference threads this stream gets;
+// `instance` names the pipeline ("front" or "front#3" after restarts) in GStreamer's logs.
+// Throws std::runtime_error naming the element that could not be made.
+std::unique_ptr<StreamGraph> build_stream_graph(const StreamConfig& config, int threads, const std::string& instance);
+
+// The first index not used yet by files matching printf-style `pattern` ("…%05d…") in its
+// folder, so a restarted stream never overwrites what an earlier run wrote.
+int next_free_index(const std::string& pattern);
+
+}  // namespace neuflow::daemon

@@ -1,0 +1,383 @@
+#!/usr/bin/env python3
+"""End-to-end tests of neuflowd as a real process, the way systemd runs it.
+
+Each test writes a config into a temporary folder, starts `neuflowd --config` with a
+NOTIFY_SOCKET this test owns (so READY=1, RELOADING=1, STATUS=, WATCHDOG=1 are observed as
+systemd would see them), reads what the sinks produce, and signals the process.
+
+Environment (set by CTest, see e2e_tests.cmake): NEUFLOWD, NEUFLOW_SHM_READER, GST_LAUNCH,
+GST_PLUGIN_PATH_1_0 / GST_REGISTRY_1_0 (the plugin in the build tree), NEUFLOW_SHARED_DIR
+and NEUFLOW_REQUIRE_FIXTURES (the checkpoint fixture).
+Run one test: e2e_test.py DaemonLifecycle.test_ready_flows_reload_and_clean_stop
+"""
+import os
+import queue
+import re
+import shutil
+import signal
+import socket
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+import urllib.request
+
+SKIP = 77
+
+
+def shared_dir():
+    d = os.environ.get("NEUFLOW_SHARED_DIR")
+    if d:
+        return d
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "shared")
+
+
+CHECKPOINT = os.path.join(shared_dir(), "fixtures", "neuflow-v2-seed0", "checkpoint.pth")
+
+
+class NotifySocket:
+    """The service manager's end of sd_notify: a datagram socket collecting messages."""
+
+    def __init__(self, folder):
+        self.path = os.path.join(folder, "notify.sock")
+        self.sock = socket.socket(socket.AF_UNIX, socket.SOCK_DGRAM)
+        self.sock.bind(self.path)
+        self.sock.settimeout(0.2)
+        self.messages = queue.Queue()
+        self.seen = []
+        self._stop = False
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+
+    def _run(self):
+        while not self._stop:
+            try:
+                data = self.sock.recv(4096)
+            except socket.timeout:
+                continue
+            except OSError:
+                return
+            for line in data.decode().splitlines():
+                self.messages.put(line)
+
+    def wait_for(self, prefix, timeout):
+        """Returns the first message starting with `prefix` (earlier ones are kept in .seen)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            try:
+                m = self.messages.get(timeout=0.2)
+            except queue.Empty:
+                continue
+            self.seen.append(m)
+            if m.startswith(prefix):
+                return m
+        raise AssertionError(f"no {prefix!r} within {timeout} s; got {self.seen[-10:]}")
+
+    def close(self):
+        self._stop = True
+        self._thread.join()
+        self.sock.close()
+
+
+class Daemon:
+    def __init__(self, folder, config_text, extra_env=None):
+        self.folder = folder
+        self.config = os.path.join(folder, "neuflowd.toml")
+        with open(self.config, "w") as f:
+            f.write(config_text)
+        self.notify = NotifySocket(folder)
+        self.log_path = os.path.join(folder, "neuflowd.log")
+        env = dict(os.environ)
+        env["NOTIFY_SOCKET"] = self.notify.path
+        env.update(extra_env or {})
+        self.log = open(self.log_path, "w")
+        self.proc = subprocess.Popen([os.environ["NEUFLOWD"], "--config", self.config, "--log-level", "debug"],
+                                     stdout=self.log, stderr=subprocess.STDOUT, env=env)
+
+    def rewrite(self, config_text):
+        tmp = self.config + ".new"
+        with open(tmp, "w") as f:
+            f.write(config_text)
+        os.replace(tmp, self.config)
+
+    def log_text(self):
+        with open(self.log_path) as f:
+            return f.read()
+
+    def wait_log(self, pattern, timeout):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if re.search(pattern, self.log_text()):
+                return
+            if self.proc.poll() is not None:
+                break
+            time.sleep(0.2)
+        raise AssertionError(f"log never matched {pattern!r}:\n{self.log_text()[-4000:]}")
+
+    def stop(self, timeout=60):
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+        try:
+            code = self.proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+            raise AssertionError(f"neuflowd did not stop within {timeout} s:\n{self.log_text()[-4000:]}")
+        return code
+
+    def close(self):
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+        self.log.close()
+        self.notify.close()
+
+
+def read_flo(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    magic, w, h = struct.unpack("<fii", data[:12])
+    assert abs(magic - 202021.25) < 1e-3, f"{path}: bad .flo magic"
+    assert len(data) == 12 + w * h * 8, f"{path}: {len(data)} bytes for {w}x{h}"
+    return w, h
+
+
+def flow_files(folder):
+    return sorted(f for f in os.listdir(folder) if f.endswith(".flo")) if os.path.isdir(folder) else []
+
+
+def mp4_decodes(path):
+    """Frames decoded from an MP4, or an exception with GStreamer's complaint."""
+    out = subprocess.run([os.environ["GST_LAUNCH"], "-q", "filesrc", f"location={path}", "!", "qtdemux", "!",
+                          "h264parse", "!", "avdec_h264", "!", "fakesink", "silent=false", "-v"],
+                         capture_output=True, text=True, timeout=60)
+    if out.returncode != 0:
+        raise AssertionError(f"{path} does not play: {out.stderr[-2000:]}")
+    return out.stdout.count("chain")
+
+
+def stream_block(name, source, sinks, behaviour="live"):
+    text = f"""
+[[stream]]
+name = "{name}"
+  [stream.source]
+{source}
+  [stream.flow]
+  model = "{CHECKPOINT}"
+  iters-s16 = 1
+  iters-s8 = 1
+  threads = 1
+  behaviour = "{behaviour}"
+"""
+    for sink in sinks:
+        text += "  [[stream.sink]]\n" + sink + "\n"
+    return text
+
+
+def test_source(frames=-1, fps=10):
+    return f"""  type = "test"
+  pattern = "ball"
+  width = 64
+  height = 48
+  framerate = {fps}
+  frames = {frames}"""
+
+
+class DaemonTestCase(unittest.TestCase):
+    def setUp(self):
+        if not os.path.isfile(CHECKPOINT):
+            msg = f"fixture checkpoint not found: {CHECKPOINT} (set NEUFLOW_SHARED_DIR)"
+            if os.environ.get("NEUFLOW_REQUIRE_FIXTURES", "0") not in ("", "0"):
+                self.fail(msg)
+            self.skipTest(msg)
+        self.dir = tempfile.mkdtemp(prefix="neuflowd-e2e-")
+        self.daemons = []
+        self.tag = f"{os.getpid()}-{self.id().split('.')[-1]}"
+
+    def tearDown(self):
+        for d in self.daemons:
+            d.close()
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def start(self, config_text, **kw):
+        d = Daemon(self.dir, config_text, **kw)
+        self.daemons.append(d)
+        return d
+
+
+class DaemonLifecycle(DaemonTestCase):
+    def test_ready_flows_reload_and_clean_stop(self):
+        shm = f"/neuflowd-e2e-{self.tag}"[:60]
+        files_a = os.path.join(self.dir, "pattern-flows")
+        files_b = os.path.join(self.dir, "clip-flows")
+        files_b2 = os.path.join(self.dir, "clip-flows-2")
+        mp4 = os.path.join(self.dir, "viz.mp4")
+        clip = os.path.join(self.dir, "clip.mp4")
+        subprocess.run([os.environ["GST_LAUNCH"], "-q", "videotestsrc", "num-buffers=12", "pattern=ball", "!",
+                        "video/x-raw,width=64,height=48,framerate=10/1", "!", "x264enc", "!", "mp4mux", "!",
+                        "filesink", f"location={clip}"], check=True, timeout=60)
+
+        def config(clip_dir):
+            return (stream_block("pattern", test_source(), [
+                f'  type = "files"\n  directory = "{files_a}"\n  max-files = 50',
+                f'  type = "shm"\n  shm-name = "{shm}"\n  slots = 4',
+                f'  type = "video"\n  file = "{mp4}"',
+            ]) + stream_block("clip", f'  type = "uri"\n  path = "{clip}"',
+                              [f'  type = "files"\n  directory = "{clip_dir}"'], behaviour="every-pair"))
+
+        d = self.start(config(files_b))
+        d.notify.wait_for("READY=1", timeout=60)
+
+        # The file stream converts every pair and finishes; the live one keeps producing.
+        d.wait_log(r"stream clip: end of input", timeout=90)
+        self.assertEqual(len(flow_files(files_b)), 11, d.log_text()[-3000:])
+        for f in flow_files(files_b):
+            self.assertEqual(read_flo(os.path.join(files_b, f)), (64, 48))
+        with open(os.path.join(files_b, "index.csv")) as f:
+            self.assertEqual(len(f.read().strip().splitlines()), 1 + 11)
+
+        deadline = time.monotonic() + 60
+        while len(flow_files(files_a)) < 3 and time.monotonic() < deadline:
+            time.sleep(0.2)
+        self.assertGreaterEqual(len(flow_files(files_a)), 3, d.log_text()[-3000:])
+
+        # A separate process follows the shared-memory ring and checks every flow is whole.
+        reader = subprocess.run([os.environ["NEUFLOW_SHM_READER"], "--check", "--count", "5", "--timeout", "60", shm],
+                                capture_output=True, text=True, timeout=90)
+        self.assertEqual(reader.returncode, 0, reader.stdout[-2000:] + reader.stderr[-2000:])
+
+        # SIGHUP with one stream changed: only that one restarts.
+        d.rewrite(config(files_b2))
+        d.proc.send_signal(signal.SIGHUP)
+        d.notify.wait_for("RELOADING=1", timeout=30)
+        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_log(r"stream clip: end of input.*\n(.*\n)*.*stream clip: end of input", timeout=90)
+        self.assertEqual(len(flow_files(files_b2)), 11)
+        log = d.log_text()
+        self.assertIn("stream clip: settings changed", log)
+        self.assertNotIn("stream pattern: settings changed", log)
+        self.assertEqual(log.count("stream pattern: starting"), 1, log[-3000:])
+
+        code = d.stop()
+        self.assertEqual(code, 0, d.log_text()[-3000:])
+        self.assertIn("STOPPING=1", d.notify.seen + list(d.notify.messages.queue))
+        segments = sorted(f for f in os.listdir(self.dir) if f.startswith("viz") and f.endswith(".mp4"))
+        self.assertEqual(len(segments), 1, segments)
+        self.assertGreater(mp4_decodes(os.path.join(self.dir, segments[0])), 0)
+        # No half-written flow files: every file in the folder reads back whole.
+        for f in os.listdir(files_a):
+            self.assertFalse(f.startswith(".") or f.endswith(".tmp"), f"temporary left behind: {f}")
+            if f.endswith(".flo"):
+                read_flo(os.path.join(files_a, f))
+
+    def test_watchdog_and_status(self):
+        d = self.start(stream_block("w", test_source(), ['  type = "files"\n  directory = "%s"' %
+                                                         os.path.join(self.dir, "w")]),
+                       extra_env={"WATCHDOG_USEC": "2000000"})
+        d.notify.wait_for("READY=1", timeout=60)
+        d.notify.wait_for("WATCHDOG=1", timeout=10)
+        d.notify.wait_for("WATCHDOG=1", timeout=10)
+        status = d.notify.wait_for("STATUS=w ", timeout=30)
+        self.assertRegex(status, r"STATUS=w (\d+\.\d fps|playing|starting)")
+        self.assertEqual(d.stop(), 0)
+
+
+class DaemonFailures(DaemonTestCase):
+    def test_failing_source_restarts_while_other_stream_runs(self):
+        # Nothing listens on this port: the RTSP source fails at once, every time.
+        probe = socket.socket()
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+        probe.close()
+        metrics = socket.socket()
+        metrics.bind(("127.0.0.1", 0))
+        metrics_port = metrics.getsockname()[1]
+        metrics.close()
+        good = os.path.join(self.dir, "good")
+        text = (f'[daemon]\nrestart-delay-min = 0.5\nrestart-delay-max = 2.0\n'
+                f'[metrics]\nlisten = "127.0.0.1:{metrics_port}"\n' +
+                stream_block("broken", f'  type = "uri"\n  uri = "rtsp://127.0.0.1:{port}/nothing"',
+                             ['  type = "files"\n  directory = "%s"' % os.path.join(self.dir, "broken")]) +
+                stream_block("good", test_source(), [f'  type = "files"\n  directory = "{good}"']))
+        d = self.start(text)
+        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_log(r"stream broken: .*restarting in", timeout=60)
+        before = len(flow_files(good))
+        d.wait_log(r"stream broken: .*restarting in(.*\n)+.*stream broken: .*restarting in", timeout=60)
+        deadline = time.monotonic() + 30
+        while len(flow_files(good)) <= before and time.monotonic() < deadline:
+            time.sleep(0.2)
+        self.assertGreater(len(flow_files(good)), before, "the good stream stopped producing")
+
+        body = urllib.request.urlopen(f"http://127.0.0.1:{metrics_port}/metrics", timeout=10).read().decode()
+        restarts = re.search(r'neuflow_stream_restarts_total\{stream="broken"\} (\d+)', body)
+        self.assertIsNotNone(restarts, body)
+        self.assertGreaterEqual(int(restarts.group(1)), 2)
+        processed = re.search(r'neuflow_frames_processed_total\{stream="good"\} (\d+)', body)
+        self.assertGreater(int(processed.group(1)), 0)
+        self.assertEqual(d.stop(), 0)
+
+    def test_failing_sink_is_cut_off_and_the_stream_goes_on(self):
+        doomed = os.path.join(self.dir, "doomed")
+        kept = os.path.join(self.dir, "kept")
+        d = self.start(stream_block("s", test_source(), [
+            f'  type = "files"\n  name = "doomed"\n  directory = "{doomed}"',
+            f'  type = "files"\n  name = "kept"\n  directory = "{kept}"',
+        ]))
+        d.notify.wait_for("READY=1", timeout=60)
+        deadline = time.monotonic() + 60
+        while len(flow_files(doomed)) < 2 and time.monotonic() < deadline:
+            time.sleep(0.2)
+        # The folder disappears under the sink and a file takes its place: every write fails,
+        # even for root.
+        shutil.rmtree(doomed)
+        with open(doomed, "w") as f:
+            f.write("not a folder\n")
+        d.wait_log(r"stream s: sink doomed failed: .*other sinks", timeout=30)
+        before = len(flow_files(kept))
+        deadline = time.monotonic() + 30
+        while len(flow_files(kept)) < before + 3 and time.monotonic() < deadline:
+            time.sleep(0.2)
+        self.assertGreaterEqual(len(flow_files(kept)), before + 3, d.log_text()[-3000:])
+        self.assertNotIn("restarting in", d.log_text())
+        self.assertEqual(d.stop(), 0)
+
+
+class CheckConfig(DaemonTestCase):
+    def run_check(self, text):
+        path = os.path.join(self.dir, "check.toml")
+        with open(path, "w") as f:
+            f.write(text)
+        return subprocess.run([os.environ["NEUFLOWD"], "--check-config", path], capture_output=True, text=True,
+                              timeout=60), path
+
+    def test_valid_config_passes(self):
+        out, path = self.run_check(stream_block("ok", test_source(), [
+            '  type = "files"\n  directory = "%s"' % os.path.join(self.dir, "x")]))
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertIn("OK, 1 stream", out.stdout)
+
+    def test_errors_name_line_and_exit_78(self):
+        text = stream_block("bad", test_source(), ['  type = "files"\n  directory = "%s"\n  colour = "red"' %
+                                                   os.path.join(self.dir, "x")])
+        out, path = self.run_check(text)
+        self.assertEqual(out.returncode, 78, out.stderr)
+        line = next(i for i, l in enumerate(text.splitlines(), 1) if "colour" in l)
+        self.assertRegex(out.stderr, re.escape(path) + f":{line}:\\d+: .*colour")
+
+    def test_missing_model_is_reported_at_start_too(self):
+        text = stream_block("bad", test_source(), ['  type = "files"\n  directory = "%s"' %
+                                                   os.path.join(self.dir, "x")]).replace(CHECKPOINT, "/nonexistent.pth")
+        out, _ = self.run_check(text)
+        self.assertEqual(out.returncode, 78)
+        self.assertIn("/nonexistent.pth", out.stderr)
+        d = self.start(text)
+        self.assertEqual(d.proc.wait(timeout=60), 78)
+        self.assertIn("/nonexistent.pth", d.log_text())
+
+
+if __name__ == "__main__":
+    unittest.main()
