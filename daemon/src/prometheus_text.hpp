@@ -1,0 +1,46 @@
+#pragma once
+// neuflowd's metrics in the Prometheus text exposition format (version 0.0.4): what the
+// metrics endpoint serves. Pure formatting of a snapshot the daemon takes on its main thread,
+// so it is tested without a network and the endpoint never touches the streams themselves.
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace neuflow::daemon {
+
+// One stream as the daemon last saw it. The counters should count since the daemon started,
+// summed over the stream's restarts: Prometheus reads any decrease as a counter reset.
+struct StreamMetrics {
+  std::string stream;          // StreamConfig::name; unique within a snapshot
+  std::string state;           // "playing", "starting", "backoff", "stopped", "finished"
+  std::uint64_t frames_in = 0;
+  std::uint64_t frames_processed = 0;
+  std::uint64_t frames_dropped = 0;
+  std::uint64_t flows = 0;           // flow fields delivered to the sinks
+  std::uint64_t restarts = 0;
+  std::uint64_t sink_failures = 0;
+  double latency_ms_mean = 0.0;      // mean inference time of recent flows; NaN: none yet
+  double processing_fps = 0.0;       // flows per second, recent
+  double uptime_s = 0.0;             // since the stream last reached "playing"; 0 when not playing
+};
+
+// The states render_prometheus reports as neuflow_stream_state series, one each per stream.
+inline constexpr const char* kStreamStates[] = {"playing", "starting", "backoff", "stopped",
+                                                "finished"};
+
+// The whole exposition: one family per metric, each with its # HELP and # TYPE once, samples
+// ordered as the snapshot. Families of per-stream metrics are left out when there are no
+// streams. Latency is exported in seconds (Prometheus' base unit) as
+// neuflow_inference_latency_seconds.
+std::string render_prometheus(const std::vector<StreamMetrics>& streams, double daemon_uptime_s);
+
+// A label value escaped for the text format: backslash, double quote and line feed become
+// \\, \" and \n; everything else (UTF-8 included) is kept.
+std::string escape_label_value(std::string_view value);
+
+// A sample value: integers as such, other numbers in the shortest form that reads back
+// exactly, and NaN, +Inf, -Inf spelled as the format wants.
+std::string format_sample_value(double value);
+
+}  // namespace neuflow::daemon
