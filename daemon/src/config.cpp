@@ -1,2 +1,77 @@
-// Placeholder: the config loader is being written.
+// Loading a config: the file → TOML → Config, then what it refers to on this machine. The
+// schema lives in config_read*.cpp, the machine checks in config_environment.cpp.
 #include "config.hpp"
+
+#include <gst/gst.h>
+#include <toml++/toml.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "config_environment.hpp"
+#include "config_issues.hpp"
+#include "config_read.hpp"
+#include "config_toml.hpp"
+
+namespace neuflow::daemon {
+namespace {
+
+std::string summary(const std::vector<ConfigIssue>& issues) {
+  std::string text;
+  for (const auto& issue : issues) {
+    if (!text.empty()) text += '\n';
+    text += issue.to_string();
+  }
+  return text;
+}
+
+[[noreturn]] void fail(const std::filesystem::path& file, std::string message) {
+  throw ConfigError({ConfigIssue{file, 0, 0, std::move(message)}});
+}
+
+}  // namespace
+
+std::string ConfigIssue::to_string() const {
+  std::string text = file.string();
+  if (line > 0) {
+    text += ':' + std::to_string(line);
+    if (column > 0) text += ':' + std::to_string(column);
+  }
+  return text + ": " + message;
+}
+
+ConfigError::ConfigError(std::vector<ConfigIssue> issues)
+    : std::runtime_error(summary(issues)), issues_(std::move(issues)) {}
+
+Config load_config(const std::filesystem::path& file, ConfigChecks checks) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) fail(file, "is a folder; expected a TOML config file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) fail(file, std::string("cannot open the config file: ") + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) fail(file, std::string("cannot read the config file: ") + std::strerror(errno));
+  return parse_config(text.str(), file, checks);
+}
+
+Config parse_config(const std::string& text, const std::filesystem::path& file, ConfigChecks checks) {
+  if (checks == ConfigChecks::all && !gst_is_initialized()) {
+    throw std::logic_error("neuflowd config: call gst_init() before checking a config against this machine");
+  }
+  Issues issues(file);
+  toml::table root;
+  try {
+    root = toml::parse(std::string_view(text), std::string_view(file.string()));
+  } catch (const toml::parse_error& error) {
+    issues.add(position_of(error.source()), "invalid TOML: " + std::string(error.description()));
+    throw ConfigError(issues.take_sorted());
+  }
+  ReadResult result = read_config(root, file, issues);
+  if (checks == ConfigChecks::all) check_machine(result.needs, installed_gstreamer(), issues);
+  if (!issues.empty()) throw ConfigError(issues.take_sorted());
+  return std::move(result.config);
+}
+
+}  // namespace neuflow::daemon

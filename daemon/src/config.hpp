@@ -187,14 +187,25 @@ class ConfigError : public std::runtime_error {
   std::vector<ConfigIssue> issues_;
 };
 
-// Reads and checks a config file: TOML syntax, unknown keys, types and ranges, required keys,
-// and what it refers to on this machine (the model file, v4l2 device nodes, input files, that
-// output directories can be created, that the GStreamer elements a stream needs are installed).
-// Throws ConfigError.
-Config load_config(const std::filesystem::path& file);
+// How far the loader looks.
+enum class ConfigChecks {
+  // The file alone: TOML syntax, unknown keys, types and ranges, required keys, names and
+  // references between streams. Needs nothing from the machine (the shipped examples are
+  // tested this way on machines without their cameras and models).
+  file_only,
+  // Also what the file refers to on this machine: the model file, v4l2 device nodes, input
+  // files, that output directories exist or can be created, that the GStreamer elements a
+  // stream needs are installed. The caller must have called gst_init() (std::logic_error if not).
+  all,
+};
+
+// Reads and checks a config file (see ConfigChecks). Relative paths in it are resolved against
+// the file's folder; the Config holds absolute paths. Throws ConfigError with every issue found.
+Config load_config(const std::filesystem::path& file, ConfigChecks checks = ConfigChecks::all);
 
 // The same from a string (tests); `file` only names it in messages, and relative paths in
 // the config are resolved against its folder.
-Config parse_config(const std::string& text, const std::filesystem::path& file);
+Config parse_config(const std::string& text, const std::filesystem::path& file,
+                    ConfigChecks checks = ConfigChecks::all);
 
 }  // namespace neuflow::daemon
