@@ -17,10 +17,18 @@
  * timestamps are those of the two frames the flow was computed from; after dropped frames
  * they are not consecutive, so consumers should pair flows with frames through this file.
  *
+ * #neuflowsink:max-files and #neuflowsink:max-bytes bound what a long run leaves on disk:
+ * after each file written, the oldest files this element wrote (since it started) are
+ * deleted until both limits hold; the newest file is always kept. With either set, the index
+ * is rewritten atomically with only the rows whose files still exist whenever it holds more
+ * than twice as many rows as there are files kept (and at least 32 rows), and once more when
+ * the element stops: its size stays bounded at an amortized constant cost per flow.
+ *
  * Buffers without flow (the first frame of a stream, frames the inference element dropped)
  * are skipped and counted in #neuflowsink:buffers-skipped. A file that cannot be written
  * (missing directory, disk full, no permission) stops the pipeline with an error naming
- * the file and the reason.
+ * the file and the reason; the error message is posted before the flow error is returned,
+ * so an application sees which sink failed before the pipeline reacts to the failure.
  *
  * As a file writer, the sink does not synchronize to the clock by default (sync=false).
  *
@@ -34,6 +42,7 @@
 
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cinttypes>
 #include <cstdio>
@@ -42,12 +51,15 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <system_error>
 
 #include "elements.hpp"
+#include "flow_index_compaction.hpp"
 #include "neuflow/flow/errors.hpp"
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/gst/flow_meta.h"
+#include "written_files.hpp"
 
 GST_DEBUG_CATEGORY_STATIC(gst_neuflow_sink_debug);
 #define GST_CAT_DEFAULT gst_neuflow_sink_debug
@@ -57,6 +69,8 @@ enum {
   PROP_LOCATION,
   PROP_INDEX,
   PROP_INDEX_LOCATION,
+  PROP_MAX_FILES,
+  PROP_MAX_BYTES,
   PROP_FLOWS_WRITTEN,
   PROP_BUFFERS_SKIPPED,
 };
@@ -66,6 +80,9 @@ enum {
 #define DEFAULT_INDEX_LOCATION nullptr /* index.csv in the directory of location */
 #define INDEX_FILE_NAME "index.csv"
 #define INDEX_HEADER "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file\n"
+// The index is compacted when it holds more than twice the rows of the files kept, but never
+// for fewer rows than this: tiny limits would otherwise rewrite it every other flow.
+#define INDEX_MIN_LIVE_ROWS 16
 
 struct GstNeuflowSink {
   GstBaseSink parent;
@@ -74,6 +91,8 @@ struct GstNeuflowSink {
   gchar *location;
   gchar *index_location;
   gint index;  // of the next file
+  guint64 max_files;  // 0: no limit
+  guint64 max_bytes;
   guint64 flows_written;
   guint64 buffers_skipped;
 
@@ -82,6 +101,15 @@ struct GstNeuflowSink {
   gchar *index_path;       // where the index goes, or nullptr when disabled
   gchar *index_dir;        // its directory, to name files beside it by their base name
   FILE *index_file;        // opened at the first flow written
+
+  // Retention, streaming thread only. Files are tracked only while a limit is set: without
+  // one, a weeks-long run would otherwise keep one entry per flow in memory.
+  neuflow::gst::WrittenFiles *written;  // files of this run, oldest first
+  guint64 index_rows;                   // data rows in the index file, once counted
+  gboolean index_rows_known;
+  guint64 index_foreign_rows;           // rows of files not in `written` (earlier runs), at most
+  guint64 index_compact_floor;          // no compaction below this many rows (after a failure)
+  guint64 files_removed;                // since the last compaction
 };
 
 struct GstNeuflowSinkClass {
@@ -173,6 +201,12 @@ static void gst_neuflow_sink_set_property(GObject *object, guint prop_id, const 
       g_free(self->index_location);
       self->index_location = g_value_dup_string(value);
       break;
+    case PROP_MAX_FILES:
+      self->max_files = g_value_get_uint64(value);
+      break;
+    case PROP_MAX_BYTES:
+      self->max_bytes = g_value_get_uint64(value);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -192,6 +226,12 @@ static void gst_neuflow_sink_get_property(GObject *object, guint prop_id, GValue
       break;
     case PROP_INDEX_LOCATION:
       g_value_set_string(value, self->index_location);
+      break;
+    case PROP_MAX_FILES:
+      g_value_set_uint64(value, self->max_files);
+      break;
+    case PROP_MAX_BYTES:
+      g_value_set_uint64(value, self->max_bytes);
       break;
     case PROP_FLOWS_WRITTEN:
       g_value_set_uint64(value, self->flows_written);
@@ -214,6 +254,13 @@ static void gst_neuflow_sink_clear_run_state(GstNeuflowSink *self) {
   g_clear_pointer(&self->pattern, g_free);
   g_clear_pointer(&self->index_path, g_free);
   g_clear_pointer(&self->index_dir, g_free);
+  delete self->written;
+  self->written = nullptr;
+  self->index_rows = 0;
+  self->index_rows_known = FALSE;
+  self->index_foreign_rows = 0;
+  self->index_compact_floor = 0;
+  self->files_removed = 0;
 }
 
 static void gst_neuflow_sink_finalize(GObject *object) {
@@ -278,10 +325,81 @@ static gboolean gst_neuflow_sink_start(GstBaseSink *sink) {
   GST_INFO_OBJECT(self, "writing flow to %s from index %d, index file %s", location, index,
                   index_path ? index_path : "(none)");
   gst_neuflow_sink_clear_run_state(self);
+  self->written = new neuflow::gst::WrittenFiles;
   self->pattern = g_steal_pointer(&location);
   self->index_path = g_steal_pointer(&index_path);
   self->index_dir = g_steal_pointer(&index_dir);
   return TRUE;
+}
+
+// Rewrites the index without the rows of deleted files. A failure leaves the index valid
+// (only longer than it should be): it is posted as a warning, and the next attempt waits
+// until the index has doubled so that a persistent problem does not cost a rewrite per flow.
+static void gst_neuflow_sink_compact_index(GstNeuflowSink *self) {
+  if (self->index_file) {  // reopened for appending at the next row
+    std::fclose(self->index_file);
+    self->index_file = nullptr;
+  }
+  try {
+    const auto result = neuflow::gst::compact_flow_index(self->index_path, self->index_dir);
+    const guint64 ours = self->written->count();
+    self->index_rows = result.rows_kept;
+    self->index_foreign_rows = result.rows_kept > ours ? result.rows_kept - ours : 0;
+    self->index_compact_floor = 0;
+    self->files_removed = 0;
+    GST_DEBUG_OBJECT(self, "index %s compacted: kept %zu rows, dropped %zu", self->index_path, result.rows_kept,
+                     result.rows_dropped);
+  } catch (const std::exception &e) {
+    GST_ELEMENT_WARNING(self, RESOURCE, WRITE,
+                        ("Could not remove the rows of deleted flow files from the index \"%s\": %s.", self->index_path,
+                         e.what()),
+                        (nullptr));
+    self->index_compact_floor = 2 * self->index_rows;
+  }
+}
+
+// After `path` (just written, with its index row) deletes the oldest files of this run until
+// max-files and max-bytes hold, and compacts the index once it holds more than twice the
+// rows of the files kept. Deletion problems are warnings: the flow itself was written.
+static void gst_neuflow_sink_apply_retention(GstNeuflowSink *self, const std::string &path) {
+  GST_OBJECT_LOCK(self);
+  const guint64 max_files = self->max_files;
+  const guint64 max_bytes = self->max_bytes;
+  GST_OBJECT_UNLOCK(self);
+  if (max_files == 0 && max_bytes == 0) return;
+
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  self->written->add(path, ec ? 0 : static_cast<std::uint64_t>(size));
+  for (const std::string &old : self->written->take_excess(max_files, max_bytes)) {
+    ++self->files_removed;
+    if (std::remove(old.c_str()) != 0 && errno != ENOENT) {
+      const int err = errno;
+      GST_ELEMENT_WARNING(self, RESOURCE, WRITE,
+                          ("Could not delete the old flow file \"%s\" (max-files=%" G_GUINT64_FORMAT
+                           ", max-bytes=%" G_GUINT64_FORMAT "): %s.",
+                           old.c_str(), max_files, max_bytes, g_strerror(err)),
+                          (nullptr));
+    } else {
+      GST_LOG_OBJECT(self, "deleted %s", old.c_str());
+    }
+  }
+
+  if (!self->index_path) return;
+  if (!self->index_rows_known) {
+    // Counted once, when retention first applies: the rows of earlier runs are part of it.
+    self->index_rows_known = TRUE;
+    try {
+      self->index_rows = neuflow::gst::count_index_rows(self->index_path);
+    } catch (const std::exception &e) {
+      GST_WARNING_OBJECT(self, "%s", e.what());
+      self->index_rows = 0;
+    }
+    const guint64 ours = self->written->count();
+    self->index_foreign_rows = self->index_rows > ours ? self->index_rows - ours : 0;
+  }
+  const guint64 live = std::max<guint64>(self->index_foreign_rows + self->written->count(), INDEX_MIN_LIVE_ROWS);
+  if (self->index_rows > std::max(2 * live, self->index_compact_floor)) gst_neuflow_sink_compact_index(self);
 }
 
 static gboolean gst_neuflow_sink_stop(GstBaseSink *sink) {
@@ -290,6 +408,8 @@ static gboolean gst_neuflow_sink_stop(GstBaseSink *sink) {
   GST_INFO_OBJECT(self, "wrote %" G_GUINT64_FORMAT " flow files, skipped %" G_GUINT64_FORMAT " buffers without flow",
                   self->flows_written, self->buffers_skipped);
   GST_OBJECT_UNLOCK(self);
+  // Leaves an index that lists exactly the files kept.
+  if (self->index_path && self->files_removed > 0) gst_neuflow_sink_compact_index(self);
   gst_neuflow_sink_clear_run_state(self);
   return TRUE;
 }
@@ -301,6 +421,7 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
                                           const std::string &file) {
   if (!self->index_path) return true;
   if (!self->index_file) {
+    // Closed by compaction too, which renames a new file over the index.
     self->index_file = std::fopen(self->index_path, "a");
     struct stat st {};
     if (!self->index_file || fstat(fileno(self->index_file), &st) != 0 ||
@@ -333,6 +454,7 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
                       (nullptr));
     return false;
   }
+  ++self->index_rows;
   return true;
 }
 
@@ -370,6 +492,7 @@ static GstFlowReturn gst_neuflow_sink_render(GstBaseSink *sink, GstBuffer *buffe
                  meta->width, meta->height, meta->from_frame, meta->to_frame);
 
   if (!gst_neuflow_sink_append_index(self, index, meta, path)) return GST_FLOW_ERROR;
+  gst_neuflow_sink_apply_retention(self, path);
 
   GST_OBJECT_LOCK(self);
   self->index = index + 1;
@@ -410,9 +533,28 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
                           "CSV file that gets one row per flow file, flushed at once: "
                           "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file (timestamps in ns, empty when "
                           "unknown; file by its base name when it lies beside the index, else as written). Rows are "
-                          "appended; the header is written into an empty file. Unset: index.csv in the directory "
-                          "of location; empty string: no index",
+                          "appended; the header is written into an empty file. With max-files or max-bytes set, the "
+                          "index is rewritten atomically with only the rows of files still on disk whenever it holds "
+                          "more than twice as many rows as files kept (at least 32 rows), and when the element "
+                          "stops, so it stays bounded. Unset: index.csv in the directory of location; empty string: "
+                          "no index",
                           DEFAULT_INDEX_LOCATION, rw_ready));
+  g_object_class_install_property(
+      gobject_class, PROP_MAX_FILES,
+      g_param_spec_uint64("max-files", "Maximum files",
+                          "Keep at most this many flow files: after each file written, the oldest files this element "
+                          "wrote since it started (not those of earlier runs, nor those written while no limit was "
+                          "set) are deleted, oldest first, and their index rows dropped. 0: no limit",
+                          0, G_MAXUINT64, 0,
+                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
+  g_object_class_install_property(
+      gobject_class, PROP_MAX_BYTES,
+      g_param_spec_uint64("max-bytes", "Maximum bytes",
+                          "Keep the flow files at most this many bytes in all, deleting the oldest as for max-files "
+                          "(both limits hold when both are set); the newest file is always kept, even when it alone "
+                          "is larger. 0: no limit",
+                          0, G_MAXUINT64, 0,
+                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
   g_object_class_install_property(
       gobject_class, PROP_FLOWS_WRITTEN,
       g_param_spec_uint64("flows-written", "Flows written", "Flow files written since the element started", 0,
@@ -444,5 +586,13 @@ static void gst_neuflow_sink_init(GstNeuflowSink *self) {
   self->index_path = nullptr;
   self->index_dir = nullptr;
   self->index_file = nullptr;
+  self->max_files = 0;
+  self->max_bytes = 0;
+  self->written = nullptr;
+  self->index_rows = 0;
+  self->index_rows_known = FALSE;
+  self->index_foreign_rows = 0;
+  self->index_compact_floor = 0;
+  self->files_removed = 0;
   gst_base_sink_set_sync(GST_BASE_SINK(self), FALSE);  // a file writer, like filesink
 }

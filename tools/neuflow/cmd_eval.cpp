@@ -1,6 +1,210 @@
-// Placeholder: replaced by the real `neuflow eval` subcommand.
+// `neuflow eval`: accuracy on the standard benchmarks (MPI-Sintel, KITTI-2015, Middlebury,
+// FlyingChairs), scored the way the NeuFlow-V2 paper and its reference evaluation report it.
+// The work is in neuflow::eval (tools/neuflow/eval); this file is the command line.
+#include <cstddef>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
 #include "commands.hpp"
+#include "neuflow/eval/errors.hpp"
+#include "neuflow/eval/evaluate.hpp"
+#include "neuflow/eval/layouts.hpp"
+#include "neuflow/eval/model_predictor.hpp"
+#include "neuflow/eval/prediction_files.hpp"
+#include "neuflow/eval/report.hpp"
+#include "neuflow/flow/errors.hpp"
+#include "neuflow/model/checkpoint.hpp"
+#include "neuflow/model/flow_model.hpp"
 
 namespace neuflow::cli {
-void register_eval(CLI::App&) {}
+
+namespace {
+
+struct EvalArgs {
+  std::string dataset, root, model, predictions, json;
+  std::string pass = "both";
+  std::string channel_order = "rgb";
+  bool per_sequence = false;
+  std::size_t max_pairs = 0;
+  int iters_s16 = 1;
+  int iters_s8 = 8;
+  int threads = 0;
+};
+
+constexpr const char* kFooter =
+    "Layouts (ROOT is the dataset folder; for Sintel and KITTI also its training/ folder, for\n"
+    "FlyingChairs also its data/ folder):\n"
+    "  sintel      training/{clean,final}/<scene>/frame_NNNN.png, training/flow/<scene>/frame_NNNN.flo\n"
+    "              (each .flo: its frame and the next one)\n"
+    "  kitti       training/image_2/NNNNNN_10.png, NNNNNN_11.png, training/flow_occ/NNNNNN_10.png\n"
+    "  middlebury  other-data/<seq>/frame10.png, frame11.png, other-gt-flow/<seq>/flow10.flo\n"
+    "  chairs      data/NNNNN_img1.ppm, NNNNN_img2.ppm, NNNNN_flow.flo; with FlyingChairs_train_val.txt\n"
+    "              beside data/, only the validation pairs (label 2)\n"
+    "Padding as the reference evaluation (RAFT/NeuFlow-V2 InputPadder): edge replication to\n"
+    "multiples of 16, centred for Sintel, Middlebury and FlyingChairs, at the bottom (and centred\n"
+    "across) for KITTI; the flow is cropped back before scoring.\n"
+    "Aggregation as the reference: Sintel, Middlebury, FlyingChairs: EPE and <1/3/5 px over all\n"
+    "valid pixels of all pairs together; KITTI: EPE = mean of the per-image EPEs over valid\n"
+    "pixels, Fl-all (error > 3 px and > 5% of |gt|) and <1/3/5 px over all valid pixels together.\n"
+    "Per sequence: Sintel scenes, Middlebury sequences, single pairs for KITTI and FlyingChairs.\n"
+    "--predictions DIR: one flow file per pair at DIR/<first image's path relative to the layout\n"
+    "root (training/ for Sintel and KITTI, data/ for FlyingChairs), extension replaced by .flo,\n"
+    ".png (KITTI 16-bit) or .npy>, e.g. DIR/clean/alley_1/frame_0001.flo, DIR/image_2/000000_10.png,\n"
+    "DIR/other-data/RubberWhale/frame10.flo, DIR/00001_img1.flo.\n"
+    "Progress goes to stderr, the table to stdout (to stderr with --json -).\n"
+    "Exit status: 66 missing dataset, image, ground truth, prediction or model; 65 malformed\n"
+    "input (undecodable, sizes that disagree); 73 JSON not writable; 1 otherwise.";
+
+// Reports on stderr after a set's last pair and otherwise at most every few seconds, so a
+// long model run shows it is alive without flooding the log.
+class ProgressPrinter {
+ public:
+  void operator()(const eval::EvalProgress& p) {
+    if (p.done == 1) last_ = 0;
+    if (p.done != p.total && p.elapsed_seconds - last_ < 5.0) return;
+    last_ = p.elapsed_seconds;
+    std::fprintf(stderr, "eval: %s %zu/%zu pairs, EPE %.3f so far, %.2f s/pair\n", p.set.name.c_str(), p.done,
+                 p.total, p.so_far.epe, p.elapsed_seconds / static_cast<double>(p.done));
+  }
+
+ private:
+  double last_ = 0;  // elapsed seconds at the last line
+};
+
+eval::FlowSource make_source(const EvalArgs& a) {
+  if (!a.predictions.empty()) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(a.predictions, ec)) {
+      throw CommandError(kExitNoInput, "eval: " + a.predictions + ": no such predictions folder");
+    }
+    return eval::PredictionReader(a.predictions);
+  }
+  std::shared_ptr<const model::FlowModel> model;
+  try {
+    model = model::FlowModel::load(a.model);
+  } catch (const model::CheckpointError& e) {
+    throw CommandError(exit_code_for(e), std::string("eval: ") + e.what());
+  }
+  eval::ModelPredictorOptions options;
+  options.iterations = {a.iters_s16, a.iters_s8};
+  options.threads = a.threads;
+  options.feed_bgr = a.channel_order == "bgr";
+  // FlowSource is copyable and FlowSession is not: share one predictor.
+  auto predictor = std::make_shared<eval::ModelPredictor>(std::move(model), options);
+  return [predictor](const eval::EvalSet& set, const eval::Pair& pair) { return (*predictor)(set, pair); };
+}
+
+void write_json(const std::string& path, const std::string& text) {
+  if (path == "-") {
+    std::fputs(text.c_str(), stdout);
+    return;
+  }
+  // Through a temporary sibling, so a script never reads half a result.
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.close();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(temporary, ec);
+      throw CommandError(kExitCantCreate, "eval: " + path + ": cannot write the JSON results");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    throw CommandError(kExitCantCreate, "eval: " + path + ": cannot write the JSON results (" + ec.message() + ")");
+  }
+}
+
+void run(const EvalArgs& a) {
+  const auto dataset = eval::parse_dataset(a.dataset);
+  if (!dataset) throw CommandError(kExitFailure, "eval: unknown dataset '" + a.dataset + "'");
+  eval::LayoutOptions layout;
+  layout.sintel_pass = a.pass == "clean" ? eval::SintelPass::clean
+                       : a.pass == "final" ? eval::SintelPass::final
+                                           : eval::SintelPass::both;
+  const std::vector<eval::EvalSet> sets = eval::discover_sets(*dataset, a.root, layout);
+  const eval::FlowSource source = make_source(a);
+
+  eval::EvaluateOptions options;
+  options.max_pairs = a.max_pairs;
+  options.progress = ProgressPrinter();
+  std::vector<eval::SetResult> results;
+  for (const auto& set : sets) results.push_back(eval::evaluate_set(set, source, options));
+
+  const std::string table = eval::format_table(results, a.per_sequence);
+  std::fputs(table.c_str(), a.json == "-" ? stderr : stdout);
+  if (!a.json.empty()) {
+    eval::RunDescription run;
+    run.dataset = *dataset;
+    run.root = std::filesystem::absolute(a.root);
+    if (!a.model.empty()) run.model = std::filesystem::absolute(a.model);
+    if (!a.predictions.empty()) run.predictions = std::filesystem::absolute(a.predictions);
+    run.iterations = {a.iters_s16, a.iters_s8};
+    run.feed_bgr = a.channel_order == "bgr";
+    run.max_pairs = a.max_pairs;
+    write_json(a.json, eval::format_json(run, results, a.per_sequence));
+  }
+}
+
+void run_mapping_errors(const EvalArgs& a) {
+  try {
+    run(a);
+  } catch (const eval::EvalError& e) {
+    throw CommandError(e.kind() == eval::EvalError::Kind::missing_input ? kExitNoInput : kExitDataError,
+                       std::string("eval: ") + e.what());
+  } catch (const flow::FlowFileError& e) {
+    throw CommandError(exit_code_for(e), std::string("eval: ") + e.what());
+  }
+}
+
+}  // namespace
+
+void register_eval(CLI::App& app) {
+  auto a = std::make_shared<EvalArgs>();
+  auto* cmd = app.add_subcommand("eval", "Accuracy on MPI-Sintel, KITTI-2015, Middlebury or FlyingChairs as the paper reports it");
+  cmd->footer(kFooter);
+  cmd->add_option("--dataset,-d", a->dataset, "Benchmark layout under ROOT")
+      ->required()
+      ->check(CLI::IsMember({"sintel", "kitti", "middlebury", "chairs"}));
+  cmd->add_option("ROOT", a->root, "The dataset's folder")->required();
+  auto* source = cmd->add_option_group("source", "What to score (exactly one)");
+  auto* model = source->add_option("--model,-m", a->model, "NeuFlow-V2 checkpoint (.pth) to run on every pair");
+  source->add_option("--predictions", a->predictions, "Score precomputed flow files from this folder instead (naming below)");
+  source->require_option(1);
+  cmd->add_option("--pass", a->pass, "Sintel passes to evaluate")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"clean", "final", "both"}));
+  cmd->add_option("--json", a->json, "Also write the results as JSON to FILE ('-': stdout)");
+  cmd->add_flag("--per-sequence", a->per_sequence, "Break the results down by sequence");
+  cmd->add_option("--max-pairs", a->max_pairs, "Score only the first N pairs of each set (default: all)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--iters-s16", a->iters_s16, "Refinement iterations at 1/16 resolution")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 32))
+      ->needs(model);
+  cmd->add_option("--iters-s8", a->iters_s8, "Refinement iterations at 1/8 resolution")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64))
+      ->needs(model);
+  cmd->add_option("--threads", a->threads, "CPU threads (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber)
+      ->needs(model);
+  cmd->add_option("--channel-order", a->channel_order,
+                  "Channel order fed to the network: rgb as it was trained, bgr as the reference demo scripts")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"rgb", "bgr"}))
+      ->needs(model);
+  cmd->callback([a] { run_mapping_errors(*a); });
+}
+
 }  // namespace neuflow::cli
