@@ -19,7 +19,8 @@ constexpr guint kTickMs = 500;
 
 }  // namespace
 
-Daemon::Daemon(Config config) : config_(std::move(config)) { loop_ = g_main_loop_new(nullptr, FALSE); }
+Daemon::Daemon(Config config, std::string log_level_override)
+    : config_(std::move(config)), log_level_override_(std::move(log_level_override)) { loop_ = g_main_loop_new(nullptr, FALSE); }
 
 Daemon::~Daemon() {
   for (guint id : sources_) g_source_remove(id);
@@ -96,12 +97,16 @@ void Daemon::retire(std::unique_ptr<Stream> stream, std::function<void()> then) 
 void Daemon::apply(Config next) {
   const Config previous = std::move(config_);
   config_ = std::move(next);
+  if (!log_level_override_.empty()) config_.daemon.log_level = log_level_override_;
   set_log_level(parse_log_level(config_.daemon.log_level));
 
   std::map<std::string, const StreamConfig*> wanted;
   for (const StreamConfig& s : config_.streams) wanted[s.name] = &s;
 
-  const bool daemon_settings_changed = !(previous.daemon == config_.daemon);
+  // The log level is applied above; every other [daemon] setting shapes the streams.
+  DaemonSettings before = previous.daemon, after = config_.daemon;
+  before.log_level = after.log_level;
+  const bool daemon_settings_changed = !(before == after);
   for (auto it = streams_.begin(); it != streams_.end();) {
     auto w = wanted.find(it->first);
     const bool keep = w != wanted.end() && it->second->config() == *w->second &&

@@ -24,7 +24,8 @@ class RtspServer;
 
 class Daemon {
  public:
-  explicit Daemon(Config config);
+  // `log_level_override`: --log-level, kept over reloads; empty: the config's.
+  explicit Daemon(Config config, std::string log_level_override = {});
   ~Daemon();
   Daemon(const Daemon&) = delete;
   Daemon& operator=(const Daemon&) = delete;
@@ -49,6 +50,7 @@ class Daemon {
   std::string render_metrics() const;
 
   Config config_;
+  std::string log_level_override_;
   GMainLoop* loop_ = nullptr;
   Notifier notifier_;
   std::map<std::string, std::unique_ptr<Stream>> streams_;

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -57,11 +58,14 @@ void use_log_prefix_from_environment() { g_prefix = stderr_is_journal(); }
 
 void log(LogLevel level, const std::string& message) {
   if (static_cast<int>(level) > static_cast<int>(g_level.load())) return;
+  // One line per event: GStreamer's debug strings carry line breaks of their own.
+  std::string line = message;
+  std::replace(line.begin(), line.end(), '\n', ' ');
   std::lock_guard lock(g_write_mutex);
   if (g_prefix) {
-    std::fprintf(stderr, "<%d>%s\n", static_cast<int>(level), message.c_str());
+    std::fprintf(stderr, "<%d>%s\n", static_cast<int>(level), line.c_str());
   } else {
-    std::fprintf(stderr, "neuflowd: %s: %s\n", level_name(level), message.c_str());
+    std::fprintf(stderr, "neuflowd: %s: %s\n", level_name(level), line.c_str());
   }
   std::fflush(stderr);
 }

@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
     Config config = load_config(config_file);
     if (!level.empty()) config.daemon.log_level = level;
     set_log_level(parse_log_level(config.daemon.log_level));
-    Daemon daemon(std::move(config));
+    Daemon daemon(std::move(config), level);
     return daemon.run();
   } catch (const ConfigError& e) {
     print_issues(e);

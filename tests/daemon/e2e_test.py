@@ -151,7 +151,7 @@ def flow_files(folder):
 
 def mp4_decodes(path):
     """Frames decoded from an MP4, or an exception with GStreamer's complaint."""
-    out = subprocess.run([os.environ["GST_LAUNCH"], "-q", "filesrc", f"location={path}", "!", "qtdemux", "!",
+    out = subprocess.run([os.environ["GST_LAUNCH"], "filesrc", f"location={path}", "!", "qtdemux", "!",
                           "h264parse", "!", "avdec_h264", "!", "fakesink", "silent=false", "-v"],
                          capture_output=True, text=True, timeout=60)
     if out.returncode != 0:
@@ -177,13 +177,13 @@ name = "{name}"
     return text
 
 
-def test_source(frames=-1, fps=10):
-    return f"""  type = "test"
+def test_source(frames=None, fps=10):
+    text = f"""  type = "test"
   pattern = "ball"
   width = 64
   height = 48
-  framerate = {fps}
-  frames = {frames}"""
+  framerate = {fps}"""
+    return text + (f"\n  frames = {frames}" if frames else "")
 
 
 class DaemonTestCase(unittest.TestCase):
