@@ -1,6 +1,201 @@
-// Placeholder: replaced by the real `neuflow convert` subcommand.
+// neuflow convert: optical flow for every consecutive pair of frames of image pairs, folders
+// of frames and videos, written as flow files with an index, optionally rendered.
+#include <unistd.h>
+#include <sys/ioctl.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
 #include "commands.hpp"
+#include "convert_inputs.hpp"
+#include "convert_job.hpp"
+#include "convert_progress.hpp"
+#include "neuflow/model/checkpoint.hpp"
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/flow_session.hpp"
 
 namespace neuflow::cli {
-void register_convert(CLI::App&) {}
+
+namespace {
+
+struct ConvertArgs {
+  std::string model;
+  std::vector<std::string> inputs;
+  std::vector<std::pair<std::string, std::string>> pairs;
+  std::string output;
+  int model_width = 0, model_height = 0;
+  int iters_s16 = 1, iters_s8 = 8;
+  int threads = 0;
+  // Words, mapped after parsing (CLI11 2.1 cannot print FlowFormat's default).
+  std::string channel_order = "rgb";
+  std::string format = "flo";
+  std::string viz = "none";
+  double max_flow = 20;
+  bool resume = false;
+  std::int64_t max_frames = 0;
+};
+
+int terminal_width(int fd) {
+  winsize size{};
+  if (::ioctl(fd, TIOCGWINSZ, &size) == 0 && size.ws_col > 0) return size.ws_col;
+  return 80;
+}
+
+std::string pairs_text(std::int64_t n) { return std::to_string(n) + (n == 1 ? " pair" : " pairs"); }
+
+// "<input>: FAILED: <reason>", without naming the input twice when the reason starts with it.
+std::string failure_text(const InputSpec& input, const InputError& error) {
+  std::string reason = error.what();
+  if (reason.rfind(input.label + ": ", 0) == 0) reason.erase(0, input.label.size() + 2);
+  return input.label + ": FAILED: " + reason;
+}
+
+std::string summary_line(const InputSpec& input, const InputOutcome& outcome) {
+  if (outcome.error) return "  " + failure_text(input, *outcome.error);
+  const std::int64_t pairs = outcome.pairs_written + outcome.pairs_skipped;
+  char timing[64];
+  std::snprintf(timing, sizeof timing, " in %s", Progress::format_duration(outcome.seconds).c_str());
+  std::string line = "  " + input.label + " -> " + outcome.output.string() + ": " + pairs_text(pairs) + " (" +
+                     std::to_string(outcome.pairs_written) + " written, " + std::to_string(outcome.pairs_skipped) +
+                     " skipped)" + timing;
+  if (outcome.pairs_written > 0 && outcome.seconds > 0) {
+    char rate[48];
+    std::snprintf(rate, sizeof rate, ", %.2f pairs/s", static_cast<double>(outcome.pairs_written) / outcome.seconds);
+    line += rate;
+  }
+  return line;
+}
+
+void run_convert(const ConvertArgs& a) {
+  if ((a.model_width == 0) != (a.model_height == 0)) {
+    throw CommandError(kExitFailure, "--model-width and --model-height go together (both 0: the frames' own size)");
+  }
+  for (const int side : {a.model_width, a.model_height}) {
+    if (side != 0 && (side % 16 != 0 || side < 32)) {
+      throw CommandError(kExitFailure, "--model-width/--model-height must be multiples of 16, at least 32; got " +
+                                           std::to_string(side));
+    }
+  }
+  if (a.inputs.empty() && a.pairs.empty()) throw CommandError(kExitFailure, "nothing to convert: give INPUT... or --pair A B");
+
+  std::shared_ptr<const model::FlowModel> model;
+  try {
+    model = model::FlowModel::load(a.model);
+  } catch (const model::CheckpointError& e) {
+    throw CommandError(exit_code_for(e), e.what());
+  }
+  model::SessionOptions options;
+  options.iterations = {a.iters_s16, a.iters_s8};
+  options.model_width = a.model_width;
+  options.model_height = a.model_height;
+  options.threads = a.threads;
+  model::FlowSession session(model, options);
+
+  ConvertSettings settings;
+  settings.output_dir = a.output;
+  settings.format = a.format == "npy"   ? flow::FlowFormat::npy
+                    : a.format == "png" ? flow::FlowFormat::kitti_png
+                                        : flow::FlowFormat::flo;
+  settings.viz = a.viz == "png" ? VizMode::png : a.viz == "video" ? VizMode::video : VizMode::none;
+  settings.max_flow = a.max_flow;
+  settings.resume = a.resume;
+  settings.max_frames = a.max_frames;
+  settings.network_order = a.channel_order == "bgr" ? model::ChannelOrder::bgr : model::ChannelOrder::rgb;
+
+  const int fd = ::fileno(stderr);
+  const bool terminal = ::isatty(fd) != 0;
+  Progress progress(stderr, terminal, terminal ? terminal_width(fd) : 80);
+
+  const auto inputs = plan_inputs(a.inputs, a.pairs);
+  std::vector<InputOutcome> outcomes;
+  for (const auto& input : inputs) {
+    outcomes.push_back(convert_input(input, session, settings, progress));
+    // Said at once, so a long batch does not hide an early failure until the end.
+    if (outcomes.back().error) progress.print(failure_text(input, *outcomes.back().error));
+  }
+
+  std::size_t failed = 0;
+  int exit_code = kExitOk;
+  for (const auto& outcome : outcomes) {
+    if (!outcome.error) continue;
+    if (failed++ == 0) exit_code = outcome.error->exit_code;
+  }
+  std::fprintf(stderr, "neuflow convert: %zu input%s, %zu converted, %zu failed\n", inputs.size(),
+               inputs.size() == 1 ? "" : "s", inputs.size() - failed, failed);
+  for (std::size_t i = 0; i < inputs.size(); ++i) std::fprintf(stderr, "%s\n", summary_line(inputs[i], outcomes[i]).c_str());
+  if (failed > 0) {
+    throw CommandError(exit_code, "convert: " + std::to_string(failed) + " of " + std::to_string(inputs.size()) +
+                                      " inputs failed (exit code of the first failure)");
+  }
+}
+
+}  // namespace
+
+void register_convert(CLI::App& app) {
+  auto args = std::make_shared<ConvertArgs>();
+  auto* sub = app.add_subcommand(
+      "convert",
+      "Compute the flow of every consecutive pair of frames of each INPUT (a folder of frames in natural order, a "
+      "video file or URI, or two images) into OUTPUT/<input name>/: <frame>.flo|.npy|.png per pair, index.csv "
+      "naming both frames of each flow, and optionally the colour rendering as viz/<frame>.png or viz.mp4. "
+      "Video pairs are named frame_000123 (frame 123 -> 124), images by the first image's name");
+  sub->add_option("--model,-m", args->model, "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth")
+      ->envname("NEUFLOW_MODEL")
+      ->required();
+  sub->add_option("--output,-o", args->output, "Output folder; each input gets a sub-folder named after it")
+      ->required();
+  sub->add_option("--pair", args->pairs, "Two images to compute one flow between (repeatable)");
+  sub->add_option("--format", args->format, "Flow file format: flo (Middlebury), npy (H x W x 2 float32) or png (KITTI 16-bit)")
+      ->check(CLI::IsMember({"flo", "npy", "png"}))
+      ->capture_default_str();
+  sub->add_option("--viz", args->viz,
+                  "Colour rendering of each flow: png (viz/<frame>.png), video (viz.mp4, H.264, at the video's frame "
+                  "rate, 10 fps for images) or none")
+      ->check(CLI::IsMember({"none", "png", "video"}))
+      ->capture_default_str();
+  sub->add_option("--max-flow", args->max_flow,
+                  "Flow magnitude (px) drawn fully saturated in --viz; fixed so colours mean the same in every frame")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sub->add_flag("--resume", args->resume,
+                "Keep flow files that already exist and read back complete at the frames' size; compute the rest");
+  sub->add_option("--max-frames", args->max_frames, "Only the first N frames of each input (N-1 pairs); 0: all")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            return !value.empty() && value.find_first_not_of("0123456789") == std::string::npos
+                       ? std::string()
+                       : "--max-frames wants 0 (all frames) or a number of frames, got '" + value + "'";
+          },
+          "N"));
+  sub->add_option("--model-width", args->model_width,
+                  "Width the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16384));
+  sub->add_option("--model-height", args->model_height,
+                  "Height the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 16384));
+  sub->add_option("--iters-s16", args->iters_s16, "Refinement iterations at 1/16 resolution")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 32));
+  sub->add_option("--iters-s8", args->iters_s8, "Refinement iterations at 1/8 resolution")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  sub->add_option("--channel-order", args->channel_order,
+                  "Colour order fed to the network: rgb (what the published weights were trained with) or bgr (as "
+                  "the reference demo scripts feed it)")
+      ->check(CLI::IsMember({"rgb", "bgr"}))
+      ->capture_default_str();
+  sub->add_option("--threads", args->threads, "CPU threads for inference (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  sub->add_option("INPUT", args->inputs,
+                  "Folders of frames, video files or URIs, or two image files (a pair); several at once");
+  sub->callback([args] { run_convert(*args); });
+}
+
 }  // namespace neuflow::cli

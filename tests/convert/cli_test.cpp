@@ -1,0 +1,352 @@
+// `neuflow convert` end to end: the real binary on frames from the fixture camera sequence
+// (downscaled at test time) and on videos made with GStreamer, checked against the model
+// run in this process.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "neuflow/flow/flow_io.hpp"
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/flow_session.hpp"
+#include "neuflow/pipeline/video_decoder.hpp"
+#include "support/fixtures.hpp"
+#include "test_media.hpp"
+
+namespace neuflow::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TempDir;
+
+constexpr int kWidth = 64, kHeight = 48;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+RunResult run_neuflow(const std::vector<std::string>& args) {
+  std::string command = shell_quote(NEUFLOW_BIN);
+  for (const auto& a : args) command += " " + shell_quote(a);
+  command += " 2>&1";
+  RunResult result;
+  std::FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) result.output.append(buffer, n);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::vector<std::vector<std::string>> read_csv(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::vector<std::string>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> fields;
+    std::stringstream ss(line);
+    for (std::string field; std::getline(ss, field, ',');) fields.push_back(field);
+    if (!line.empty() && line.back() == ',') fields.emplace_back();
+    rows.push_back(fields);
+  }
+  return rows;
+}
+
+double max_difference(const flow::FlowField& a, const flow::FlowField& b) {
+  if (a.width != b.width || a.height != b.height) return INFINITY;
+  double worst = 0;
+  for (std::size_t i = 0; i < a.uv.size(); ++i) worst = std::max(worst, static_cast<double>(std::abs(a.uv[i] - b.uv[i])));
+  return worst;
+}
+
+class ConvertCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    NEUFLOW_REQUIRE_FIXTURE(checkpoint, "neuflow-v2-seed0/checkpoint.pth");
+    NEUFLOW_REQUIRE_FIXTURE(frames, "frames");
+    checkpoint_ = checkpoint;
+    for (const auto& entry : fs::directory_iterator(frames)) {
+      if (entry.path().extension() == ".jpg") camera_frames_.push_back(entry.path());
+    }
+    std::sort(camera_frames_.begin(), camera_frames_.end());
+    ASSERT_GE(camera_frames_.size(), 5u);
+  }
+
+  // The first camera frames, downscaled, saved under `names` in `folder`.
+  std::vector<cv::Mat> make_frames(const fs::path& folder, const std::vector<std::string>& names,
+                                   int width = kWidth, int height = kHeight) {
+    fs::create_directories(folder);
+    std::vector<cv::Mat> images;
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const cv::Mat full = cv::imread(camera_frames_.at(i).string(), cv::IMREAD_COLOR);
+      cv::Mat small;
+      cv::resize(full, small, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+      EXPECT_TRUE(cv::imwrite((folder / names[i]).string(), small));
+      images.push_back(small);
+    }
+    return images;
+  }
+
+  std::vector<std::string> convert_args(const fs::path& output) const {
+    return {"convert", "-m", checkpoint_.string(), "--iters-s16", "1", "--iters-s8", "1", "--threads", "1",
+            "-o", output.string()};
+  }
+
+  RunResult convert(const fs::path& output, const std::vector<std::string>& more) const {
+    auto args = convert_args(output);
+    args.insert(args.end(), more.begin(), more.end());
+    return run_neuflow(args);
+  }
+
+  // The flow the library computes for one pair, with the options convert_args gives.
+  flow::FlowField reference_flow(const cv::Mat& a, const cv::Mat& b) const {
+    static const auto model = model::FlowModel::load(checkpoint_);
+    model::SessionOptions options;
+    options.iterations = {1, 1};
+    options.threads = 1;
+    model::FlowSession session(model, options);
+    const auto view = [](const cv::Mat& m) {
+      return model::ImageView{m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), model::ChannelOrder::bgr};
+    };
+    return session.compute(view(a), view(b));
+  }
+
+  fs::path checkpoint_;
+  std::vector<fs::path> camera_frames_;
+};
+
+TEST_F(ConvertCli, FolderInNaturalOrderGivesOneFlowPerPairEqualToThePairwiseResult) {
+  TempDir dir;
+  // Plain string order would be frame1, frame10, frame11, frame2, frame3.
+  const std::vector<std::string> names = {"frame1.png", "frame2.png", "frame3.png", "frame10.png", "frame11.png"};
+  const auto images = make_frames(dir / "seq", names);
+  const auto result = convert(dir / "out", {(dir / "seq").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("1 input, 1 converted, 0 failed"), std::string::npos) << result.output;
+
+  const fs::path out = dir / "out" / "seq";
+  const auto index = read_csv(out / "index.csv");
+  ASSERT_EQ(index.size(), 5u) << "header + 4 pairs";
+  EXPECT_EQ(index[0], (std::vector<std::string>{"index", "from_frame", "to_frame", "from_pts_ns", "to_pts_ns", "file",
+                                                "from_source", "to_source"}));
+  for (std::size_t i = 0; i + 1 < names.size(); ++i) {
+    const std::string stem = fs::path(names[i]).stem().string();
+    EXPECT_EQ(index[i + 1], (std::vector<std::string>{std::to_string(i), std::to_string(i), std::to_string(i + 1), "",
+                                                      "", stem + ".flo", names[i], names[i + 1]}));
+    const auto written = flow::read_flow(out / (stem + ".flo"));
+    EXPECT_EQ(written.width, kWidth);
+    EXPECT_EQ(written.height, kHeight);
+    // Streaming (backbone reused from the previous pair) gives the pairwise result.
+    EXPECT_LT(max_difference(written, reference_flow(images[i], images[i + 1])), 1e-4) << stem;
+  }
+  EXPECT_EQ(test::hidden_files(out), "");
+}
+
+TEST_F(ConvertCli, VideoGivesFlowsAndAnMp4ThatDecodes) {
+  TempDir dir;
+  const auto video = test::make_test_video(dir / "ball.mp4", 6, kWidth, kHeight);
+  const auto result = convert(dir / "out", {video.string(), "--viz", "video"});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+
+  const fs::path out = dir / "out" / "ball";
+  const auto index = read_csv(out / "index.csv");
+  ASSERT_EQ(index.size(), 6u) << "header + 5 pairs";
+  for (int i = 0; i < 5; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%06d.flo", i);
+    const auto& row = index[static_cast<std::size_t>(i) + 1];
+    ASSERT_EQ(row.size(), 8u);
+    EXPECT_EQ(row[1], std::to_string(i));
+    EXPECT_EQ(row[2], std::to_string(i + 1));
+    EXPECT_NEAR(std::stod(row[4]) - std::stod(row[3]), 100e6, 1e6);  // 10 fps
+    if (i > 0) {
+      EXPECT_EQ(row[3], index[static_cast<std::size_t>(i)][4]) << "consecutive pairs share a frame";
+    }
+    EXPECT_EQ(row[5], name);
+    const auto field = flow::read_flow(out / name);
+    EXPECT_EQ(field.width, kWidth);
+    EXPECT_EQ(field.height, kHeight);
+  }
+
+  pipeline::VideoDecoder decoder((out / "viz.mp4").string());
+  int frames = 0;
+  while (auto frame = decoder.next()) {
+    EXPECT_EQ(frame->width, kWidth);
+    EXPECT_EQ(frame->height, kHeight);
+    ++frames;
+  }
+  EXPECT_EQ(frames, 5);
+  EXPECT_EQ(decoder.frame_rate().numerator, 10);
+  EXPECT_EQ(test::hidden_files(out), "");
+}
+
+TEST_F(ConvertCli, MaxFramesLimitsEachInput) {
+  TempDir dir;
+  const auto video = test::make_test_video(dir / "ball.mp4", 6, kWidth, kHeight);
+  make_frames(dir / "seq", {"a.png", "b.png", "c.png", "d.png"});
+  const auto result = convert(dir / "out", {video.string(), (dir / "seq").string(), "--max-frames", "3"});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_EQ(read_csv(dir / "out" / "ball" / "index.csv").size(), 3u);
+  EXPECT_EQ(read_csv(dir / "out" / "seq" / "index.csv").size(), 3u);
+  EXPECT_FALSE(fs::exists(dir / "out" / "ball" / "frame_000002.flo"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "seq" / "c.flo"));
+}
+
+TEST_F(ConvertCli, ResumeRecomputesOnlyMissingOrIncompleteFlows) {
+  TempDir dir;
+  make_frames(dir / "seq", {"f1.png", "f2.png", "f3.png", "f4.png", "f5.png"});
+  const fs::path out = dir / "out" / "seq";
+  const auto full = convert(dir / "out", {(dir / "seq").string(), "--format", "npy"});
+  ASSERT_EQ(full.exit_code, 0) << full.output;
+  std::vector<flow::FlowField> original;
+  for (const char* stem : {"f1", "f2", "f3", "f4"}) original.push_back(flow::read_flow(out / (std::string(stem) + ".npy")));
+
+  fs::remove(out / "f2.npy");
+  fs::resize_file(out / "f3.npy", fs::file_size(out / "f3.npy") / 2);  // an interrupted write
+  const auto kept_time = fs::last_write_time(out / "f4.npy");
+  const auto resumed = convert(dir / "out", {(dir / "seq").string(), "--format", "npy", "--resume"});
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("4 pairs (2 written, 2 skipped)"), std::string::npos) << resumed.output;
+  EXPECT_EQ(fs::last_write_time(out / "f4.npy"), kept_time) << "a complete flow was rewritten";
+  const char* stems[] = {"f1", "f2", "f3", "f4"};
+  for (int i = 0; i < 4; ++i) {
+    // f2 follows the kept f1, so the session restarts there; the result must not change.
+    EXPECT_LT(max_difference(flow::read_flow(out / (std::string(stems[i]) + ".npy")), original[static_cast<std::size_t>(i)]), 1e-5)
+        << stems[i];
+  }
+  EXPECT_EQ(read_csv(out / "index.csv").size(), 5u) << "the index lists kept pairs too";
+}
+
+TEST_F(ConvertCli, ResumeRebuildsTheVideoFromKeptFlows) {
+  TempDir dir;
+  make_frames(dir / "seq", {"f1.png", "f2.png", "f3.png", "f4.png"});
+  const auto args = std::vector<std::string>{(dir / "seq").string(), "--viz", "video", "--resume"};
+  ASSERT_EQ(convert(dir / "out", args).exit_code, 0);
+  fs::remove(dir / "out" / "seq" / "viz.mp4");
+  const auto resumed = convert(dir / "out", args);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("3 pairs (0 written, 3 skipped)"), std::string::npos) << resumed.output;
+  pipeline::VideoDecoder decoder((dir / "out" / "seq" / "viz.mp4").string());
+  int frames = 0;
+  while (decoder.next()) ++frames;
+  EXPECT_EQ(frames, 3);
+}
+
+TEST_F(ConvertCli, UnwritableOutputFailsWithCantCreate) {
+  TempDir dir;
+  make_frames(dir / "seq", {"a.png", "b.png"});
+  std::ofstream(dir / "file") << "in the way";
+  const auto result = convert(dir / "file", {(dir / "seq").string()});
+  EXPECT_EQ(result.exit_code, 73) << result.output;
+  EXPECT_NE(result.output.find("seq: FAILED: " + (dir / "file").string()), std::string::npos) << result.output;
+}
+
+TEST_F(ConvertCli, BadInputsFailAloneAndAreNamed) {
+  TempDir dir;
+  make_frames(dir / "good", {"a.png", "b.png", "c.png"});
+  make_frames(dir / "mixed", {"a.png", "b.png"});
+  make_frames(dir / "mixed_extra", {"c.png"}, 80, 64);
+  fs::rename(dir / "mixed_extra" / "c.png", dir / "mixed" / "c.png");
+  std::ofstream(dir / "notes.mp4") << "not a video\n";
+  const auto video = test::make_test_video(dir / "ball.mp4", 3, kWidth, kHeight);
+
+  const auto result = convert(dir / "out", {(dir / "missing.mp4").string(), (dir / "good").string(),
+                                            (dir / "notes.mp4").string(), (dir / "mixed").string(), video.string()});
+  EXPECT_EQ(result.exit_code, 66) << "the first failure is the missing file\n" << result.output;
+  EXPECT_NE(result.output.find("5 inputs, 2 converted, 3 failed"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find((dir / "missing.mp4").string() + ": FAILED: no such file"), std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find((dir / "notes.mp4").string() + ": FAILED: "), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("c.png is 80x64 but b.png is 64x48"), std::string::npos) << result.output;
+
+  EXPECT_EQ(read_csv(dir / "out" / "good" / "index.csv").size(), 3u);
+  EXPECT_EQ(read_csv(dir / "out" / "ball" / "index.csv").size(), 3u);
+  // The pair before the odd frame was converted and is in the index.
+  EXPECT_TRUE(fs::exists(dir / "out" / "mixed" / "a.flo"));
+  EXPECT_EQ(read_csv(dir / "out" / "mixed" / "index.csv").size(), 2u);
+}
+
+TEST_F(ConvertCli, UndecodableVideoAloneExitsWithDataError) {
+  TempDir dir;
+  std::ofstream(dir / "notes.mp4") << "not a video\n";
+  const auto result = convert(dir / "out", {(dir / "notes.mp4").string()});
+  EXPECT_EQ(result.exit_code, 65) << result.output;
+}
+
+TEST_F(ConvertCli, ImagePairAsTwoFilesOrWithPair) {
+  TempDir dir;
+  const auto images = make_frames(dir.path(), {"left.png", "right.png"});
+  const auto result = convert(dir / "out", {(dir / "left.png").string(), (dir / "right.png").string(), "--pair",
+                                            (dir / "right.png").string(), (dir / "left.png").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const auto forward = flow::read_flow(dir / "out" / "left_right" / "left.flo");
+  const auto backward = flow::read_flow(dir / "out" / "right_left" / "right.flo");
+  EXPECT_LT(max_difference(forward, reference_flow(images[0], images[1])), 1e-4);
+  EXPECT_LT(max_difference(backward, reference_flow(images[1], images[0])), 1e-4);
+  const auto index = read_csv(dir / "out" / "left_right" / "index.csv");
+  ASSERT_EQ(index.size(), 2u);
+  EXPECT_EQ(index[1][6], "left.png");
+  EXPECT_EQ(index[1][7], "right.png");
+}
+
+TEST_F(ConvertCli, KittiFlowsAndPngRenderings) {
+  TempDir dir;
+  make_frames(dir / "seq", {"a.png", "b.png", "c.png"});
+  const auto result = convert(dir / "out", {(dir / "seq").string(), "--format", "png", "--viz", "png"});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  for (const char* stem : {"a", "b"}) {
+    const auto field = flow::read_flow(dir / "out" / "seq" / (std::string(stem) + ".png"));
+    EXPECT_TRUE(field.has_mask()) << "KITTI flow PNGs carry a validity mask";
+    const cv::Mat viz = cv::imread((dir / "out" / "seq" / "viz" / (std::string(stem) + ".png")).string());
+    EXPECT_EQ(viz.cols, kWidth);
+    EXPECT_EQ(viz.rows, kHeight);
+  }
+}
+
+TEST_F(ConvertCli, BgrChannelOrderFeedsTheNetworkSwappedChannels) {
+  TempDir dir;
+  auto images = make_frames(dir.path(), {"a.png", "b.png"});
+  const auto result = convert(dir / "out", {(dir / "a.png").string(), (dir / "b.png").string(), "--channel-order", "bgr"});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  for (auto& image : images) cv::cvtColor(image, image, cv::COLOR_BGR2RGB);
+  // The reference reads the swapped images as BGR, so the network sees the original BGR as RGB.
+  EXPECT_LT(max_difference(flow::read_flow(dir / "out" / "a_b" / "a.flo"), reference_flow(images[0], images[1])), 1e-4);
+}
+
+TEST_F(ConvertCli, SingleFrameAndEmptyFolderFail) {
+  TempDir dir;
+  make_frames(dir / "one", {"only.png"});
+  fs::create_directories(dir / "empty");
+  const auto result = convert(dir / "out", {(dir / "one").string(), (dir / "empty").string()});
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("a flow needs at least two"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("no image files"), std::string::npos) << result.output;
+}
+
+TEST_F(ConvertCli, MissingCheckpointFailsBeforeAnyInput) {
+  TempDir dir;
+  make_frames(dir / "seq", {"a.png", "b.png"});
+  const auto result = run_neuflow({"convert", "-m", (dir / "none.pth").string(), "-o", (dir / "out").string(),
+                                   (dir / "seq").string()});
+  EXPECT_EQ(result.exit_code, 66) << result.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+}  // namespace
+}  // namespace neuflow::cli
