@@ -163,9 +163,10 @@ void Daemon::update_servers() {
   }
 }
 
-std::string Daemon::render_metrics() const {
+std::string Daemon::render_metrics() {
   std::vector<StreamMetrics> all;
   for (const auto& [name, stream] : streams_) {
+    stream->refresh_counters();
     const StreamSnapshot s = stream->snapshot();
     StreamMetrics m;
     m.stream = s.name;

@@ -47,7 +47,7 @@ class Daemon {
   void update_servers();
   int threads_for(const StreamConfig& stream) const;
   std::string status_line() const;
-  std::string render_metrics() const;
+  std::string render_metrics();
 
   Config config_;
   std::string log_level_override_;

@@ -282,17 +282,19 @@ void Stream::handle_message(GstMessage* message) {
       if (GST_MESSAGE_SRC(message) != GST_OBJECT(graph_->pipeline())) return;
       GstState old_state, new_state;
       gst_message_parse_state_changed(message, &old_state, &new_state, nullptr);
-      if (new_state == GST_STATE_PLAYING && state_ == StreamState::starting) {
-        enter(StreamState::playing);
-        settled_ = true;
-        last_progress_ = Clock::now();
-        log_info("stream " + config_.name + ": playing");
-      }
+      if (new_state == GST_STATE_PLAYING && state_ == StreamState::starting) mark_playing();
       return;
     }
     default:
       return;
   }
+}
+
+void Stream::mark_playing() {
+  enter(StreamState::playing);
+  settled_ = true;
+  last_progress_ = Clock::now();
+  log_info("stream " + config_.name + ": playing");
 }
 
 void Stream::read_counters() {
@@ -320,6 +322,9 @@ void Stream::tick() {
     last_processed_ = current_.processed;
     last_progress_ = now;
   }
+  // Frames leaving the flow element mean the stream runs, even while a sink is still waiting
+  // for its first buffer (an H.264 encoder's lookahead holds back the pipeline's PLAYING).
+  if (state_ == StreamState::starting && current_.processed > 0) mark_playing();
   if (state_ == StreamState::playing && seconds_since(last_progress_) > settings_.stall_timeout) {
     fail("no frames for " + std::to_string(static_cast<int>(settings_.stall_timeout)) + " s");
   } else if (state_ == StreamState::starting && seconds_since(state_since_) > std::max(kStartTimeoutS, settings_.stall_timeout)) {

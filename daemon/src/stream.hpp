@@ -50,6 +50,8 @@ class Stream {
   void stop(std::function<void()> done);
   // Once a second: reads the counters, restarts a stalled stream.
   void tick();
+  // Reads the flow element's counters now (for a metrics scrape between ticks).
+  void refresh_counters() { read_counters(); }
 
   const std::string& name() const { return config_.name; }
   const StreamConfig& config() const { return config_; }
@@ -74,6 +76,7 @@ class Stream {
   void teardown();
   void finish_stop();
   void enter(StreamState state);
+  void mark_playing();
   void read_counters();
 
   StreamConfig config_;

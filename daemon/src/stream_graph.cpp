@@ -137,6 +137,14 @@ GstElement* h264_encoder(const std::string& name, int bitrate_kbps, bool live) {
   return enc;
 }
 
+// Sinks do not wait for a first buffer before the pipeline may play (async=false): one branch
+// that is slow to produce one (an H.264 encoder's lookahead) would otherwise hold every other
+// sink in preroll while their queues fill, and the tee would stall the whole stream.
+GstElement* no_preroll(GstElement* sink) {
+  set(sink, "async", "false");
+  return sink;
+}
+
 GstElement* leaky_queue(const std::string& name) {
   GstElement* q = make("queue", name);
   set(q, "leaky", "downstream");
@@ -155,7 +163,7 @@ GstElement* fill_branch(GstBin* bin, const std::string& stream, const SinkConfig
     if (ec) throw std::runtime_error("cannot create " + f->directory.string() + ": " + ec.message());
     const std::string pattern = (f->directory / ("flow_%08d." + f->format)).string();
     GstElement* q = make("queue", p + "queue");
-    GstElement* out = make("neuflowsink", p + "files");
+    GstElement* out = no_preroll(make("neuflowsink", p + "files"));
     set(out, "location", pattern);
     set(out, "index-location", (f->directory / "index.csv").string());
     set(out, "index", std::to_string(next_free_index(pattern)));
@@ -166,7 +174,7 @@ GstElement* fill_branch(GstBin* bin, const std::string& stream, const SinkConfig
   }
   if (const auto* s = std::get_if<ShmSink>(&sink.settings)) {
     GstElement* q = leaky_queue(p + "queue");
-    GstElement* out = make("neuflowshmsink", p + "shm");
+    GstElement* out = no_preroll(make("neuflowshmsink", p + "shm"));
     set(out, "shm-name", s->name);
     set(out, "slots", std::to_string(s->slots));
     add_chain(bin, {q, out});
@@ -176,6 +184,7 @@ GstElement* fill_branch(GstBin* bin, const std::string& stream, const SinkConfig
     GstElement* q = leaky_queue(p + "queue");
     GstElement* out = make("autovideosink", p + "display");
     set(out, "sync", "false");
+    set(out, "async-handling", "true");  // a bin: it has no `async`, but settles its own preroll
     add_chain(bin, {q, visualizer(p + "viz", d->max_flow), make("videoconvert", p + "convert"), out});
     return q;
   }
@@ -190,7 +199,10 @@ GstElement* fill_branch(GstBin* bin, const std::string& stream, const SinkConfig
       GstElement* mux = make("splitmuxsink", p + "mux");
       set(mux, "location", pattern);
       set(mux, "start-index", std::to_string(next_free_index(pattern)));
-      set(mux, "muxer-factory", v.file.extension() == ".mkv" ? "matroskamux" : "mp4mux");
+      // (muxer-factory only applies with async-finalize; the muxer and sink are given as elements.)
+      GstElement* muxer = make(v.file.extension() == ".mkv" ? "matroskamux" : "mp4mux", p + "muxer");
+      GstElement* file = no_preroll(make("filesink", p + "file"));
+      g_object_set(mux, "muxer", muxer, "sink", file, nullptr);
       set(mux, "max-size-time", std::to_string(static_cast<guint64>(v.segment_seconds) * GST_SECOND));
       add_chain(bin, {q, visualizer(p + "viz", v.max_flow), make("videoconvert", p + "convert"),
                       h264_encoder(p + "x264", v.bitrate_kbps, false), make("h264parse", p + "parse"), mux});
@@ -198,7 +210,7 @@ GstElement* fill_branch(GstBin* bin, const std::string& stream, const SinkConfig
     }
     case VideoSink::Target::rtsp: {
       GstElement* q = leaky_queue(p + "queue");
-      GstElement* out = make("intervideosink", p + "inter");
+      GstElement* out = no_preroll(make("intervideosink", p + "inter"));
       set(out, "channel", rtsp_channel_name(stream, v.rtsp_mount));
       add_chain(bin, {q, visualizer(p + "viz", v.max_flow), make("videoconvert", p + "convert"), out});
       return q;

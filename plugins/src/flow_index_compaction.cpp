@@ -5,11 +5,13 @@
 #include <filesystem>
 #include <unordered_map>
 
+#include "neuflow/flow/flow_index.hpp"
+
 namespace neuflow::gst {
 
 namespace {
 
-constexpr std::size_t kFileField = 5;  // index,from_frame,to_frame,from_pts_ns,to_pts_ns,file
+constexpr std::size_t kFileField = flow::kFlowIndexFileColumn;
 
 std::string read_index(const std::string &path, bool *exists) {
   gchar *contents = nullptr;

@@ -57,6 +57,7 @@
 #include "flow_index_compaction.hpp"
 #include "neuflow/flow/errors.hpp"
 #include "neuflow/flow/flow_field.hpp"
+#include "neuflow/flow/flow_index.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/gst/flow_meta.h"
 #include "written_files.hpp"
@@ -79,7 +80,6 @@ enum {
 #define DEFAULT_INDEX 0
 #define DEFAULT_INDEX_LOCATION nullptr /* index.csv in the directory of location */
 #define INDEX_FILE_NAME "index.csv"
-#define INDEX_HEADER "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file\n"
 // The index is compacted when it holds more than twice the rows of the files kept, but never
 // for fewer rows than this: tiny limits would otherwise rewrite it every other flow.
 #define INDEX_MIN_LIVE_ROWS 16
@@ -167,19 +167,9 @@ std::string format_location(const char *pattern, gint index) {
   return out;
 }
 
-// A CSV field, quoted when it holds a separator, a quote or a line break (RFC 4180).
-std::string csv_field(const std::string &s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
-}
-
-std::string clock_time_field(GstClockTime t) {
-  return GST_CLOCK_TIME_IS_VALID(t) ? std::to_string(t) : std::string();
+// A timestamp for the index: none when it is not known.
+std::optional<std::int64_t> index_time(GstClockTime t) {
+  return GST_CLOCK_TIME_IS_VALID(t) ? std::optional<std::int64_t>(static_cast<std::int64_t>(t)) : std::nullopt;
 }
 
 bool is_directory(const char *path) { return g_file_test(path, G_FILE_TEST_IS_DIR); }
@@ -425,7 +415,7 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
     self->index_file = std::fopen(self->index_path, "a");
     struct stat st {};
     if (!self->index_file || fstat(fileno(self->index_file), &st) != 0 ||
-        (st.st_size == 0 && std::fputs(INDEX_HEADER, self->index_file) == EOF)) {
+        (st.st_size == 0 && std::fputs(neuflow::flow::flow_index_header().c_str(), self->index_file) == EOF)) {
       const int err = errno;
       GST_ELEMENT_ERROR(self, RESOURCE, OPEN_WRITE,
                         ("Could not open the flow index \"%s\" for appending: %s.", self->index_path, g_strerror(err)),
@@ -444,9 +434,9 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
   }
   g_free(file_dir);
 
-  const std::string row = std::to_string(index) + "," + std::to_string(meta->from_frame) + "," +
-                          std::to_string(meta->to_frame) + "," + clock_time_field(meta->from_pts) + "," +
-                          clock_time_field(meta->to_pts) + "," + csv_field(name) + "\n";
+  const std::string row = neuflow::flow::flow_index_row({index, static_cast<std::int64_t>(meta->from_frame),
+                                                         static_cast<std::int64_t>(meta->to_frame),
+                                                         index_time(meta->from_pts), index_time(meta->to_pts), name});
   if (std::fputs(row.c_str(), self->index_file) == EOF || std::fflush(self->index_file) != 0) {
     const int err = errno;
     GST_ELEMENT_ERROR(self, RESOURCE, WRITE,

@@ -7,7 +7,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "neuflow/gst/flow_meta.h"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::gst_test {
 
@@ -101,31 +101,7 @@ inline std::vector<std::uint8_t> pixel_bytes(GstBuffer *buffer, GstVideoFormat f
 }
 
 // A fresh directory under the system's temporary directory, removed with its contents.
-class TempDir {
- public:
-  TempDir() {
-    GError *error = nullptr;
-    gchar *dir = g_dir_make_tmp("neuflow-gst-test-XXXXXX", &error);
-    if (dir) {
-      path_ = dir;
-      g_free(dir);
-    } else {
-      g_error_free(error);
-    }
-  }
-  ~TempDir() {
-    std::error_code ec;
-    if (!path_.empty()) std::filesystem::remove_all(path_, ec);
-  }
-  TempDir(const TempDir &) = delete;
-  TempDir &operator=(const TempDir &) = delete;
-
-  const std::filesystem::path &path() const { return path_; }
-  std::string operator/(const std::string &name) const { return (path_ / name).string(); }
-
- private:
-  std::filesystem::path path_;
-};
+using neuflow::test::TempDir;
 
 // The first error message on `bus`: its text for users and its debug details.
 struct ErrorMessage {

@@ -486,7 +486,7 @@ TEST(NeuflowShmSinkPythonReader, ReadsTheNewestFlowExactly) {
   for (int n = 0; n < 3; ++n) ASSERT_EQ(s.push(buffer_with_flow(nth_flow(n, 10, 7))), GST_FLOW_OK);
 
   TempDir dir;
-  const std::string saved = dir / "newest.npy";
+  const std::string saved = (dir / "newest.npy").string();
   const ProgramResult r = run_program({python, NEUFLOW_SHM_PY_READER, name, "--save", saved, "--wait", "5"});
   ASSERT_TRUE(r.ran) << r.err;
   ASSERT_EQ(r.exit_status, 0) << r.out << r.err;

@@ -28,13 +28,6 @@ std::vector<std::string> read_lines(const fs::path &path) {
   return lines;
 }
 
-std::vector<std::string> directory_listing(const fs::path &dir) {
-  std::vector<std::string> names;
-  for (const auto &entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
 std::string flow_name(int index) {
   char name[32];
   std::snprintf(name, sizeof name, "flow_%03d.flo", index);
@@ -51,7 +44,7 @@ std::string index_row(int index, int n) {
 const std::string kHeader = "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file";
 
 RunningSink start_file_sink(const TempDir &dir, Properties properties) {
-  properties.insert(properties.begin(), {"location", dir / "flow_%03d.flo"});
+  properties.insert(properties.begin(), {"location", (dir / "flow_%03d.flo").string()});
   return start_sink("neuflowsink", properties);
 }
 
@@ -68,11 +61,11 @@ TEST(NeuflowSinkRetention, MaxFilesKeepsTheNewestFilesAndTheIndexListsExactlyThe
   ASSERT_TRUE(s.harness);
   for (int n = 0; n < 20; ++n) {
     ASSERT_EQ(s.push(buffer_with_flow(nth_flow(n))), GST_FLOW_OK);
-    EXPECT_LE(directory_listing(dir.path()).size(), 5u + 1u) << "after flow " << n;
+    EXPECT_LE(dir.entries().size(), 5u + 1u) << "after flow " << n;
   }
   const std::vector<std::string> newest = {flow_name(15), flow_name(16), flow_name(17), flow_name(18),
                                            flow_name(19), "index.csv"};
-  EXPECT_EQ(directory_listing(dir.path()), newest);
+  EXPECT_EQ(dir.entries(), newest);
   // While running the index may still hold rows of deleted files (at most twice the live
   // ones, at least 32), but always every file on disk.
   const auto running = read_lines(dir.path() / "index.csv");
@@ -99,7 +92,7 @@ TEST(NeuflowSinkRetention, MaxBytesKeepsTheNewestFilesThatFitAndCanBeSetWhilePla
   for (int n = 1; n < 12; ++n) ASSERT_EQ(s.push(buffer_with_flow(nth_flow(n))), GST_FLOW_OK);
 
   // flow 0 was written before the limit: not this element's to delete.
-  EXPECT_EQ(directory_listing(dir.path()),
+  EXPECT_EQ(dir.entries(),
             (std::vector<std::string>{flow_name(0), flow_name(9), flow_name(10), flow_name(11), "index.csv"}));
   s.stop();
   EXPECT_EQ(read_lines(dir.path() / "index.csv"),
@@ -111,7 +104,7 @@ TEST(NeuflowSinkRetention, NewestFileIsKeptEvenWhenLargerThanMaxBytes) {
   auto s = start_file_sink(dir, {{"max-bytes", "1"}});
   ASSERT_TRUE(s.harness);
   for (int n = 0; n < 3; ++n) ASSERT_EQ(s.push(buffer_with_flow(nth_flow(n))), GST_FLOW_OK);
-  EXPECT_EQ(directory_listing(dir.path()), (std::vector<std::string>{flow_name(2), "index.csv"}));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{flow_name(2), "index.csv"}));
 }
 
 TEST(NeuflowSinkRetention, IndexStaysBoundedOnALongRun) {
@@ -148,7 +141,7 @@ TEST(NeuflowSinkRetention, RowsOfEarlierRunsStayWhileTheirFilesExistAndTheLastRo
     ASSERT_TRUE(s.harness);
     for (int n = 10; n < 14; ++n) ASSERT_EQ(s.push(buffer_with_flow(nth_flow(n))), GST_FLOW_OK);
   }
-  EXPECT_EQ(directory_listing(dir.path()),
+  EXPECT_EQ(dir.entries(),
             (std::vector<std::string>{flow_name(2), flow_name(3), flow_name(4), "index.csv"}));
   EXPECT_EQ(read_lines(dir.path() / "index.csv"),
             (std::vector<std::string>{kHeader, index_row(4, 4), index_row(2, 12), index_row(3, 13)}));
@@ -194,7 +187,7 @@ TEST(NeuflowSinkRetention, UnwritableDirectoryPostsTheErrorBeforeReturningTheFlo
   TempDir dir;
   const std::string target = unwritable_directory(dir);
   auto s = start_sink("neuflowsink", {{"location", target + "/flow_%03d.flo"},
-                                      {"index-location", dir / "index.csv"},
+                                      {"index-location", (dir / "index.csv").string()},
                                       {"max-files", "2"}});
   ASSERT_TRUE(s.harness);
   EXPECT_EQ(s.push(buffer_with_flow(nth_flow(0))), GST_FLOW_ERROR);
@@ -239,7 +232,7 @@ TEST(FlowIndexCompaction, KeepsRowsOfExistingFilesQuotedNamesAndRowsItCannotPars
   TempDir dir;
   std::ofstream(dir / "a,1.flo") << "x";
   std::ofstream(dir / "kept.flo") << "x";
-  const std::string elsewhere = dir / "sub";
+  const std::string elsewhere = (dir / "sub").string();
   fs::create_directory(elsewhere);
   std::ofstream(elsewhere + "/far.flo") << "x";
   {
@@ -252,14 +245,14 @@ TEST(FlowIndexCompaction, KeepsRowsOfExistingFilesQuotedNamesAndRowsItCannotPars
           << "3,3,4,30,40," << elsewhere << "/far.flo\n"
           << "4,4,5,40,50," << elsewhere << "/gone.flo\n";
   }
-  const auto result = gst::compact_flow_index(dir / "index.csv", dir.path().string());
+  const auto result = gst::compact_flow_index((dir / "index.csv").string(), dir.path().string());
   EXPECT_EQ(result.rows_kept, 4u);
   EXPECT_EQ(result.rows_dropped, 2u);
   EXPECT_EQ(read_lines(dir.path() / "index.csv"),
             (std::vector<std::string>{kHeader, "1,1,2,10,20,\"a,1.flo\"", "2,2,3,20,30,kept.flo", "garbage row",
                                       "3,3,4,30,40," + elsewhere + "/far.flo"}));
-  EXPECT_EQ(gst::count_index_rows(dir / "index.csv"), 4u);
-  EXPECT_EQ(gst::count_index_rows(dir / "missing.csv"), 0u);
+  EXPECT_EQ(gst::count_index_rows((dir / "index.csv").string()), 4u);
+  EXPECT_EQ(gst::count_index_rows((dir / "missing.csv").string()), 0u);
 }
 
 }  // namespace

@@ -2,7 +2,6 @@
 // same vectors, the CSV index, skipped buffers, and errors that name the file.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -86,13 +85,6 @@ void expect_flow_file(const fs::path &path, const FlowSpec &f) {
   EXPECT_EQ(field.uv, vectors_of(f)) << path;
 }
 
-std::vector<std::string> directory_listing(const fs::path &dir) {
-  std::vector<std::string> names;
-  for (const auto &entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename().string());
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
 guint64 uint64_property(GstElement *element, const char *name) {
   guint64 value = 0;
   g_object_get(element, name, &value, nullptr);
@@ -117,7 +109,7 @@ TEST(NeuflowSink, PropertiesHaveTheirDocumentedDefaults) {
 
 TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
   TempDir dir;
-  auto s = start_sink({{"location", dir / "flow_%03d.flo"}, {"index", "5"}});
+  auto s = start_sink({{"location", (dir / "flow_%03d.flo").string()}, {"index", "5"}});
   ASSERT_TRUE(s.harness);
   const FlowSpec first{8, 6, 0, 1, 0, 33333333, 0.5f};
   const FlowSpec second{8, 6, 1, 3, 33333333, 100000000, 1.25f};  // frame 2 was dropped upstream
@@ -131,7 +123,7 @@ TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
   expect_flow_file(dir.path() / "flow_005.flo", first);
   expect_flow_file(dir.path() / "flow_006.flo", second);
   expect_flow_file(dir.path() / "flow_007.flo", third);
-  EXPECT_EQ(directory_listing(dir.path()),
+  EXPECT_EQ(dir.entries(),
             (std::vector<std::string>{"flow_005.flo", "flow_006.flo", "flow_007.flo", "index.csv"}));
 
   EXPECT_EQ(read_lines(dir.path() / "index.csv"),
@@ -152,7 +144,7 @@ class NeuflowSinkFormats : public ::testing::TestWithParam<const char *> {};
 TEST_P(NeuflowSinkFormats, FormatFollowsTheExtension) {
   TempDir dir;
   const std::string pattern = std::string("f%d.") + GetParam();
-  auto s = start_sink({{"location", dir / pattern}});
+  auto s = start_sink({{"location", (dir / pattern).string()}});
   ASSERT_TRUE(s.harness);
   const FlowSpec f{10, 7, 0, 1, 0, 40000000, 3.5f};
   ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow(f)), GST_FLOW_OK);
@@ -176,13 +168,13 @@ INSTANTIATE_TEST_SUITE_P(AllFormats, NeuflowSinkFormats, ::testing::Values("flo"
 TEST(NeuflowSink, IndexIsAppendedAcrossRestartsWithOneHeader) {
   TempDir dir;
   {
-    auto s = start_sink({{"location", dir / "flow_%d.flo"}});
+    auto s = start_sink({{"location", (dir / "flow_%d.flo").string()}});
     ASSERT_TRUE(s.harness);
     ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 0, 1, 0, 10, 0.f})), GST_FLOW_OK);
     ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 1, 2, 10, 20, 0.f})), GST_FLOW_OK);
   }
   {
-    auto s = start_sink({{"location", dir / "flow_%d.flo"}, {"index", "2"}});
+    auto s = start_sink({{"location", (dir / "flow_%d.flo").string()}, {"index", "2"}});
     ASSERT_TRUE(s.harness);
     ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 0, 1, 30, 40, 0.f})), GST_FLOW_OK);
   }
@@ -193,22 +185,22 @@ TEST(NeuflowSink, IndexIsAppendedAcrossRestartsWithOneHeader) {
 
 TEST(NeuflowSink, IndexElsewhereNamesTheFilesAsWritten) {
   TempDir flows, elsewhere;
-  const std::string pattern = flows / "x,y_%02d.npy";  // a comma: the CSV field gets quoted
-  auto s = start_sink({{"location", pattern}, {"index-location", elsewhere / "list.csv"}});
+  const std::string pattern = (flows / "x,y_%02d.npy").string();  // a comma: the CSV field gets quoted
+  auto s = start_sink({{"location", pattern}, {"index-location", (elsewhere / "list.csv").string()}});
   ASSERT_TRUE(s.harness);
   ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 7, 8, 70, 80, 0.f})), GST_FLOW_OK);
   EXPECT_FALSE(fs::exists(flows.path() / "index.csv"));
   EXPECT_EQ(read_lines(elsewhere.path() / "list.csv"),
             (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file",
-                                      "0,7,8,70,80,\"" + (flows / "x,y_00.npy") + "\""}));
+                                      "0,7,8,70,80,\"" + (flows / "x,y_00.npy").string() + "\""}));
 }
 
 TEST(NeuflowSink, EmptyIndexLocationWritesNoIndex) {
   TempDir dir;
-  auto s = start_sink({{"location", dir / "flow_%d.flo"}, {"index-location", ""}});
+  auto s = start_sink({{"location", (dir / "flow_%d.flo").string()}, {"index-location", ""}});
   ASSERT_TRUE(s.harness);
   ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 0, 1, 0, 10, 0.f})), GST_FLOW_OK);
-  EXPECT_EQ(directory_listing(dir.path()), (std::vector<std::string>{"flow_0.flo"}));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"flow_0.flo"}));
 }
 
 // Starting (READY -> PAUSED) fails with an error message that contains `expected`.
@@ -228,7 +220,7 @@ class NeuflowSinkBadPatterns : public ::testing::TestWithParam<const char *> {};
 
 TEST_P(NeuflowSinkBadPatterns, AreRejectedAtStartNamingTheLocation) {
   TempDir dir;
-  const std::string location = dir / GetParam();
+  const std::string location = (dir / GetParam()).string();
   expect_start_error({{"location", location}}, "\"" + location + "\"");
 }
 
@@ -238,19 +230,19 @@ INSTANTIATE_TEST_SUITE_P(Patterns, NeuflowSinkBadPatterns,
 
 TEST(NeuflowSink, AcceptsLiteralPercentAndPrintfFlags) {
   TempDir dir;
-  auto s = start_sink({{"location", dir / "100%%_%04x.flo"}, {"index", "255"}});
+  auto s = start_sink({{"location", (dir / "100%%_%04x.flo").string()}, {"index", "255"}});
   ASSERT_TRUE(s.harness);
   ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 0, 1, 0, 10, 0.f})), GST_FLOW_OK);
-  EXPECT_TRUE(fs::exists(dir.path() / "100%_00ff.flo")) << ::testing::PrintToString(directory_listing(dir.path()));
+  EXPECT_TRUE(fs::exists(dir.path() / "100%_00ff.flo")) << ::testing::PrintToString(dir.entries());
 }
 
 TEST(NeuflowSink, MissingDirectoryFailsAtStartNamingTheLocation) {
   TempDir dir;
-  const std::string location = dir / "missing/flow_%05d.flo";
+  const std::string location = (dir / "missing/flow_%05d.flo").string();
   expect_start_error({{"location", location}}, "\"" + location + "\"");
   expect_start_error({{"location", location}}, "does not exist");
-  const std::string index = dir / "missing/index.csv";
-  expect_start_error({{"location", dir / "flow_%05d.flo"}, {"index-location", index}}, "\"" + index + "\"");
+  const std::string index = (dir / "missing/index.csv").string();
+  expect_start_error({{"location", (dir / "flow_%05d.flo").string()}, {"index-location", index}}, "\"" + index + "\"");
 }
 
 TEST(NeuflowSink, WriteFailureStopsWithAnErrorNamingTheFileAndTheReason) {
@@ -275,7 +267,7 @@ TEST(NeuflowSink, UnwritableIndexStopsWithAnErrorNamingIt) {
   TempDir dir;
   const fs::path index = dir.path() / "index.csv";
   fs::create_directory(index);  // a directory where the index file should be
-  auto s = start_sink({{"location", dir / "flow_%d.flo"}});
+  auto s = start_sink({{"location", (dir / "flow_%d.flo").string()}});
   ASSERT_TRUE(s.harness);
   EXPECT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 0, 1, 0, 10, 0.f})), GST_FLOW_ERROR);
   const ErrorMessage error = pop_error(s.bus.get());
@@ -286,7 +278,7 @@ TEST(NeuflowSink, UnwritableIndexStopsWithAnErrorNamingIt) {
 TEST(NeuflowSink, PipelineWithoutFlowReachesEosWritingNothing) {
   TempDir dir;
   const std::string launch = "videotestsrc num-buffers=7 ! video/x-raw,width=64,height=48 ! neuflowsink name=sink "
-                             "location=\"" + (dir / "flow_%05d.flo") + "\"";
+                             "location=\"" + (dir / "flow_%05d.flo").string() + "\"";
   ElementPtr pipeline = owned(gst_parse_launch(launch.c_str(), nullptr));
   ASSERT_TRUE(pipeline);
   ASSERT_NE(gst_element_set_state(pipeline.get(), GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
@@ -300,7 +292,7 @@ TEST(NeuflowSink, PipelineWithoutFlowReachesEosWritingNothing) {
   EXPECT_EQ(uint64_property(sink.get(), "buffers-skipped"), 7u);
   EXPECT_EQ(uint64_property(sink.get(), "flows-written"), 0u);
   gst_element_set_state(pipeline.get(), GST_STATE_NULL);
-  EXPECT_TRUE(directory_listing(dir.path()).empty()) << ::testing::PrintToString(directory_listing(dir.path()));
+  EXPECT_TRUE(dir.entries().empty()) << ::testing::PrintToString(dir.entries());
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/pipeline/video_decoder.hpp"
 #include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
 #include "test_media.hpp"
 
 namespace neuflow::cli {

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "convert_inputs.hpp"
+#include "support/temp_dir.hpp"
 #include "test_media.hpp"
 
 namespace neuflow::cli {

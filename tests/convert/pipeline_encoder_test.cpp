@@ -8,6 +8,7 @@
 #include "neuflow/pipeline/pipeline_error.hpp"
 #include "neuflow/pipeline/video_decoder.hpp"
 #include "neuflow/pipeline/video_encoder.hpp"
+#include "support/temp_dir.hpp"
 #include "test_media.hpp"
 
 namespace neuflow::pipeline {

@@ -2,22 +2,9 @@
 
 #include <gst/gst.h>
 
-#include <random>
 #include <stdexcept>
 
 namespace neuflow::test {
-
-TempDir::TempDir() {
-  std::random_device rd;
-  path_ = std::filesystem::temp_directory_path() / ("neuflow-convert-test-" + std::to_string(rd()) + std::to_string(rd()));
-  std::filesystem::create_directories(path_);
-}
-
-TempDir::~TempDir() {
-  std::error_code ec;
-  std::filesystem::permissions(path_, std::filesystem::perms::owner_all, std::filesystem::perm_options::add, ec);
-  std::filesystem::remove_all(path_, ec);
-}
 
 void run_gst_pipeline(const std::string& description) {
   gst_init(nullptr, nullptr);

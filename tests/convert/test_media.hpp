@@ -1,23 +1,10 @@
 #pragma once
-// Media made at test time for the convert tests: temporary folders, videos from
-// videotestsrc, small frames from the fixture camera sequence.
+// Media made at test time for the convert tests: videos from videotestsrc, small frames
+// from the fixture camera sequence. (Temporary folders: support/temp_dir.hpp.)
 #include <filesystem>
 #include <string>
 
 namespace neuflow::test {
-
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  std::filesystem::path path_;
-};
 
 // Runs a gst-launch-1.0 style pipeline description to its end; throws std::runtime_error
 // with GStreamer's message if it fails.

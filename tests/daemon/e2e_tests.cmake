@@ -19,6 +19,11 @@ set(e2e_env
   "GST_PLUGIN_PATH_1_0=$<TARGET_FILE_DIR:gstneuflow>"
   "GST_REGISTRY_1_0=${CMAKE_CURRENT_BINARY_DIR}/e2e-registry.bin"
   ${e2e_sanitizer_env})
+if(NEUFLOW_SANITIZE)
+  # The registry scan would load the instrumented plugin into GStreamer's uninstrumented
+  # gst-plugin-scanner; neuflowd (instrumented) scans in its own process instead.
+  list(APPEND e2e_env "GST_REGISTRY_FORK=no")
+endif()
 
 foreach(test_case
     DaemonLifecycle.test_ready_flows_reload_and_clean_stop

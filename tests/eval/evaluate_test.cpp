@@ -16,12 +16,13 @@
 #include "neuflow/flow/errors.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::eval {
 namespace {
 
 namespace fs = std::filesystem;
-using test::ScratchDir;
+using neuflow::test::TempDir;
 
 struct Counts {
   std::size_t valid = 0;
@@ -59,7 +60,7 @@ class EvalPredictionLayouts : public ::testing::TestWithParam<Case> {};
 TEST_P(EvalPredictionLayouts, GroundTruthScoresZeroAndAConstantOffsetScoresItsLength) {
   const Case c = GetParam();
   NEUFLOW_REQUIRE_FIXTURE(fixture, c.fixture);
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = c.arrange(fixture.parent_path(), dir.path() / "dataset");
   for (const EvalSet& set : discover_sets(c.dataset, root)) {
     SCOPED_TRACE(set.name);
@@ -103,7 +104,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(EvalPredictions, KittiAveragesEpePerImageAndPoolsFlAll) {
   NEUFLOW_REQUIRE_FIXTURE(fixture, "flow-gt/kitti");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_kitti(fixture.parent_path(), dir.path() / "KITTI");
   // A second pair with the same images and only the bottom rows of the ground truth valid
   // (KITTI's laser data has none in the sky), so the two images have different numbers of
@@ -161,7 +162,7 @@ TEST(EvalPredictions, KittiAveragesEpePerImageAndPoolsFlAll) {
 
 TEST(EvalPredictions, SintelBreaksDownByScene) {
   NEUFLOW_REQUIRE_FIXTURE(fixture, "flow-gt/sintel");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_sintel(fixture.parent_path(), dir.path() / "Sintel");
   const EvalSet set = discover_sets(Dataset::sintel, root, {SintelPass::clean}).at(0);
   // alley_1 exact, market_5 off by (3, 4): overall the pixel-weighted mean of 0 and 5.
@@ -186,7 +187,7 @@ TEST(EvalPredictions, SintelBreaksDownByScene) {
 
 TEST(EvalPredictions, MissingMalformedAndMisSizedPredictionsAreReported) {
   NEUFLOW_REQUIRE_FIXTURE(fixture, "flow-gt/middlebury");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_middlebury(fixture.parent_path(), dir.path() / "middlebury");
   const EvalSet set = discover_sets(Dataset::middlebury, root).at(0);
   const PredictionReader reader(dir.path() / "pred");

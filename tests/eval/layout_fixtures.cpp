@@ -1,23 +1,10 @@
 #include "layout_fixtures.hpp"
 
-#include <random>
-
 #include "neuflow/flow/flow_io.hpp"
 
 namespace neuflow::eval::test {
 
 namespace fs = std::filesystem;
-
-ScratchDir::ScratchDir() {
-  std::random_device rd;
-  path_ = fs::temp_directory_path() / ("neuflow-eval-test-" + std::to_string(rd()) + std::to_string(rd()));
-  fs::create_directories(path_);
-}
-
-ScratchDir::~ScratchDir() {
-  std::error_code ec;
-  fs::remove_all(path_, ec);
-}
 
 void link_file(const fs::path& target, const fs::path& link) {
   fs::create_directories(link.parent_path());

@@ -1,6 +1,7 @@
 #pragma once
 // The flow-gt fixtures arranged into each benchmark's folder layout inside a scratch folder
-// (symbolic links, nothing copied), plus prediction files derived from the ground truth.
+// (symbolic links, nothing copied; scratch folders: support/temp_dir.hpp), plus prediction
+// files derived from the ground truth.
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -9,19 +10,6 @@
 #include "neuflow/flow/flow_field.hpp"
 
 namespace neuflow::eval::test {
-
-// A fresh folder per test, removed afterwards.
-class ScratchDir {
- public:
-  ScratchDir();
-  ~ScratchDir();
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-
- private:
-  std::filesystem::path path_;
-};
 
 // A symbolic link at `link` (parents created) to `target`.
 void link_file(const std::filesystem::path& target, const std::filesystem::path& link);

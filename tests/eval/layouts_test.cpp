@@ -10,12 +10,13 @@
 #include "neuflow/eval/errors.hpp"
 #include "neuflow/eval/layouts.hpp"
 #include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::eval {
 namespace {
 
 namespace fs = std::filesystem;
-using test::ScratchDir;
+using neuflow::test::TempDir;
 
 // The EvalError discover_sets throws, or a failure when it throws none.
 EvalError discovery_error(Dataset dataset, const fs::path& root, const LayoutOptions& options = {}) {
@@ -38,7 +39,7 @@ TEST(EvalLayouts, DatasetNamesRoundTrip) {
 
 TEST(EvalLayouts, SintelHasBothPassesWithConsecutiveFramePairs) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/sintel");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_sintel(gt.parent_path(), dir.path() / "Sintel");
   const auto sets = discover_sets(Dataset::sintel, root);
   ASSERT_EQ(sets.size(), 2u);
@@ -61,7 +62,7 @@ TEST(EvalLayouts, SintelHasBothPassesWithConsecutiveFramePairs) {
 
 TEST(EvalLayouts, SintelRootMayBeTheTrainingFolderAndOnePass) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/sintel");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_sintel(gt.parent_path(), dir.path() / "Sintel");
   const auto sets = discover_sets(Dataset::sintel, root / "training/", {SintelPass::final});
   ASSERT_EQ(sets.size(), 1u);
@@ -71,7 +72,7 @@ TEST(EvalLayouts, SintelRootMayBeTheTrainingFolderAndOnePass) {
 
 TEST(EvalLayouts, SintelFlowWithoutItsNextFrameIsMissingInput) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/sintel");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_sintel(gt.parent_path(), dir.path() / "Sintel");
   fs::remove(root / "training/final/market_5/frame_0010.png");
   const EvalError e = discovery_error(Dataset::sintel, root, {SintelPass::final});
@@ -86,7 +87,7 @@ TEST(EvalLayouts, SintelFlowWithoutItsNextFrameIsMissingInput) {
 
 TEST(EvalLayouts, SintelWithoutTheRequestedPassSaysWhatWasLookedFor) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/sintel");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_sintel(gt.parent_path(), dir.path() / "Sintel");
   fs::remove_all(root / "training/final");
   EXPECT_EQ(discover_sets(Dataset::sintel, root, {SintelPass::clean}).size(), 1u);
@@ -100,7 +101,7 @@ TEST(EvalLayouts, SintelWithoutTheRequestedPassSaysWhatWasLookedFor) {
 
 TEST(EvalLayouts, KittiPairsTheTwoFramesWithFlowOcc) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/kitti");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_kitti(gt.parent_path(), dir.path() / "KITTI");
   for (const fs::path& given : {root, root / "training"}) {
     const auto sets = discover_sets(Dataset::kitti, given);
@@ -120,7 +121,7 @@ TEST(EvalLayouts, KittiPairsTheTwoFramesWithFlowOcc) {
 
 TEST(EvalLayouts, KittiWithoutSecondFrameOrGroundTruthIsMissingInput) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/kitti");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_kitti(gt.parent_path(), dir.path() / "KITTI");
   fs::remove(root / "training/image_2/000000_11.png");
   EXPECT_NE(std::string(discovery_error(Dataset::kitti, root).what()).find("000000_11.png: no such image"),
@@ -133,7 +134,7 @@ TEST(EvalLayouts, KittiWithoutSecondFrameOrGroundTruthIsMissingInput) {
 
 TEST(EvalLayouts, MiddleburyPairsFrame10And11PerSequence) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/middlebury");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_middlebury(gt.parent_path(), dir.path() / "middlebury");
   // A file that is not flowNN.flo is not ground truth.
   std::ofstream(root / "other-gt-flow/Urban2/readme.flo") << "x";
@@ -148,7 +149,7 @@ TEST(EvalLayouts, MiddleburyPairsFrame10And11PerSequence) {
 
 TEST(EvalLayouts, ChairsUsesTheValidationSplitWhenPresent) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/flyingchairs");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_chairs(gt.parent_path(), dir.path() / "FlyingChairs_release");
   auto sets = discover_sets(Dataset::chairs, root);
   ASSERT_EQ(sets.size(), 1u);
@@ -169,7 +170,7 @@ TEST(EvalLayouts, ChairsUsesTheValidationSplitWhenPresent) {
 
 TEST(EvalLayouts, ChairsSplitFileThatDoesNotFitIsMalformed) {
   NEUFLOW_REQUIRE_FIXTURE(gt, "flow-gt/flyingchairs");
-  ScratchDir dir;
+  TempDir dir;
   const fs::path root = test::arrange_chairs(gt.parent_path(), dir.path() / "chairs");
   std::ofstream(root / "FlyingChairs_train_val.txt") << "1\n2\n2\n";
   EvalError e = discovery_error(Dataset::chairs, root);
@@ -188,7 +189,7 @@ TEST(EvalLayouts, ChairsSplitFileThatDoesNotFitIsMalformed) {
 }
 
 TEST(EvalLayouts, MissingOrEmptyRootsSayWhatWasLookedFor) {
-  ScratchDir dir;
+  TempDir dir;
   const EvalError absent = discovery_error(Dataset::kitti, dir.path() / "nowhere");
   EXPECT_EQ(absent.kind(), EvalError::Kind::missing_input);
   EXPECT_NE(std::string(absent.what()).find("nowhere: no such dataset folder"), std::string::npos) << absent.what();
@@ -212,7 +213,7 @@ TEST(EvalLayouts, MissingOrEmptyRootsSayWhatWasLookedFor) {
 }
 
 TEST(EvalLayouts, LayoutInBothRootAndTrainingIsAmbiguous) {
-  ScratchDir dir;
+  TempDir dir;
   for (const char* sub : {"image_2", "flow_occ", "training/image_2", "training/flow_occ"}) {
     fs::create_directories(dir.path() / "kitti" / sub);
   }

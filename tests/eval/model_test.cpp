@@ -16,6 +16,7 @@
 #include "neuflow/eval/model_predictor.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::eval {
 namespace {
@@ -71,7 +72,7 @@ class EvalModel : public ::testing::Test {
 TEST_F(EvalModel, RunsEndToEndOnAnOddSizedKittiPair) {
   NEUFLOW_REQUIRE_FIXTURE(checkpoint, "neuflow-v2-seed0/checkpoint.pth");
   NEUFLOW_REQUIRE_FIXTURE(kitti, "flow-gt/kitti");
-  test::ScratchDir dir;
+  neuflow::test::TempDir dir;
   const fs::path root = arrange_small_kitti(kitti, dir.path() / "KITTI");
   const EvalSet set = discover_sets(Dataset::kitti, root).at(0);
   ModelPredictor predictor(model_, tiny());
@@ -156,7 +157,7 @@ TEST_F(EvalModel, UnusableImagesAreMalformedInput) {
     EXPECT_NE(std::string(e.what()).find("cannot run the network on a 20x10 pair"), std::string::npos) << e.what();
   }
 
-  test::ScratchDir dir;
+  neuflow::test::TempDir dir;
   std::ofstream(dir.path() / "not-an-image.png") << "text";
   try {
     read_bgr_image(dir.path() / "not-an-image.png");

@@ -10,6 +10,7 @@
 
 #include "layout_fixtures.hpp"
 #include "neuflow/eval/report.hpp"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::eval {
 namespace {
@@ -29,7 +30,7 @@ SetResult sample_set(const std::string& name, Dataset dataset, Aggregation aggre
 int run_python(const std::string& json, const std::string& script) {
   const std::string python = NEUFLOW_EVAL_PYTHON3;
   if (python.empty()) return -1;
-  test::ScratchDir dir;
+  neuflow::test::TempDir dir;
   std::ofstream(dir.path() / "out.json") << json;
   std::ofstream(dir.path() / "check.py") << script;
   const std::string command =

@@ -6,6 +6,7 @@
 #include "checkpoint_builder.hpp"
 #include "neuflow/model/architecture.hpp"
 #include "neuflow/model/checkpoint.hpp"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::test {
 namespace {

@@ -2,12 +2,10 @@
 
 #include <zip.h>
 
-#include <atomic>
 #include <bit>
 #include <cstring>
 #include <fstream>
 #include <memory>
-#include <random>
 #include <stdexcept>
 
 #include "neuflow/model/architecture.hpp"
@@ -275,26 +273,6 @@ FakeCheckpoint fake_neuflow_checkpoint() {
     ckpt.tensors.push_back(std::move(t));
   }
   return ckpt;
-}
-
-TempDir::TempDir() {
-  static std::atomic<int> counter{0};
-  std::random_device rd;
-  const auto base = std::filesystem::temp_directory_path();
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    auto candidate = base / ("neuflow_ckpt_test_" + std::to_string(rd()) + "_" +
-                             std::to_string(counter++));
-    if (std::filesystem::create_directory(candidate)) {
-      path_ = candidate;
-      return;
-    }
-  }
-  throw std::runtime_error("cannot create a temporary folder");
-}
-
-TempDir::~TempDir() {
-  std::error_code ec;
-  std::filesystem::remove_all(path_, ec);
 }
 
 std::string read_file(const std::filesystem::path& path) {

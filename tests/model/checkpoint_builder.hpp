@@ -105,20 +105,6 @@ struct FakeCheckpoint {
 // shared float storage (and one int64 storage for the counters), so the file stays small.
 FakeCheckpoint fake_neuflow_checkpoint();
 
-// A unique, empty temporary folder, removed on destruction.
-class TempDir {
- public:
-  TempDir();
-  ~TempDir();
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const std::filesystem::path& path() const { return path_; }
-  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  std::filesystem::path path_;
-};
-
 std::string read_file(const std::filesystem::path& path);
 void write_file(const std::filesystem::path& path, std::string_view bytes);
 

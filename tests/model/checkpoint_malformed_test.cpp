@@ -9,6 +9,7 @@
 #include "checkpoint_builder.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::test {
 namespace {

@@ -10,6 +10,7 @@
 #include "neuflow/model/architecture.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
 
 namespace neuflow::test {
 namespace {

@@ -14,10 +14,6 @@ namespace neuflow::cli {
 
 namespace {
 
-std::string optional_field(const std::optional<std::int64_t>& value) {
-  return value ? std::to_string(*value) : std::string();
-}
-
 // Temporary file beside the target, flushed to disk, renamed over it: the same guarantee
 // the flow library gives the flow files.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text) {
@@ -47,23 +43,9 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
 
 }  // namespace
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += c;
-  }
-  return out + "\"";
-}
-
 void FlowIndex::write() const {
-  std::string text = std::string(kIndexHeader) + "\n";
-  for (const auto& r : rows_) {
-    text += std::to_string(r.index) + "," + std::to_string(r.from_frame) + "," + std::to_string(r.to_frame) + "," +
-            optional_field(r.from_pts_ns) + "," + optional_field(r.to_pts_ns) + "," + csv_field(r.file) + "," +
-            csv_field(r.from_source) + "," + csv_field(r.to_source) + "\n";
-  }
+  std::string text = flow::flow_index_header({"from_source", "to_source"});
+  for (const auto& r : rows_) text += flow::flow_index_row(r.flow, {r.from_source, r.to_source});
   write_text_atomically(path_, text);
 }
 

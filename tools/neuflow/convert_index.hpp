@@ -1,25 +1,23 @@
 #pragma once
 // The sidecar index of one converted input: one row per flow file, naming the two frames it
 // was computed from. The first six columns are those of neuflowsink's index
-// (index,from_frame,to_frame,from_pts_ns,to_pts_ns,file), so one reader handles both; two
-// more name the source images: from_source,to_source (empty for video frames).
-#include <cstdint>
+// (index,from_frame,to_frame,from_pts_ns,to_pts_ns,file: neuflow/flow/flow_index.hpp), so one
+// reader handles both; two more name the source images: from_source,to_source (empty for
+// video frames).
 #include <filesystem>
-#include <optional>
 #include <string>
 #include <vector>
+
+#include "neuflow/flow/flow_index.hpp"
 
 namespace neuflow::cli {
 
 inline constexpr const char* kIndexFileName = "index.csv";
-inline constexpr const char* kIndexHeader = "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source";
 
 struct IndexRow {
-  std::int64_t index = 0;  // the pair's position in the input, from 0
-  std::int64_t from_frame = 0;
-  std::int64_t to_frame = 0;
-  std::optional<std::int64_t> from_pts_ns, to_pts_ns;  // empty in the file when unknown
-  std::string file;  // the flow file's name, relative to the index
+  // index: the pair's position in the input, from 0; file: the flow file's name, relative
+  // to the index.
+  flow::FlowIndexRow flow;
   std::string from_source, to_source;
 };
 
@@ -37,8 +35,5 @@ class FlowIndex {
   std::filesystem::path path_;
   std::vector<IndexRow> rows_;
 };
-
-// A CSV field, quoted when it holds a separator, a quote or a line break (RFC 4180).
-std::string csv_field(const std::string& s);
 
 }  // namespace neuflow::cli
