@@ -294,6 +294,37 @@ class DaemonLifecycle(DaemonTestCase):
         self.assertEqual(d.stop(), 0)
 
 
+def free_port(kind=socket.SOCK_STREAM):
+    s = socket.socket(socket.AF_INET, kind)
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+class DaemonVideoOut(DaemonTestCase):
+    def test_rtsp_mount_and_rtp_udp_deliver_decodable_h264(self):
+        rtsp_port = free_port()
+        udp_port = free_port(socket.SOCK_DGRAM)
+        d = self.start(f'[rtsp]\nlisten = "127.0.0.1:{rtsp_port}"\n' + stream_block("cam", test_source(), [
+            '  type = "video"\n  rtsp = "/cam"',
+            f'  type = "video"\n  udp = "127.0.0.1:{udp_port}"',
+        ]))
+        d.notify.wait_for("READY=1", timeout=60)
+        caps = "application/x-rtp,media=video,encoding-name=H264,payload=96,clock-rate=90000"
+        udp = subprocess.run([os.environ["GST_LAUNCH"], "-q", "udpsrc", f"port={udp_port}", f"caps={caps}", "!",
+                              "rtph264depay", "!", "avdec_h264", "!", "video/x-raw,width=64,height=48", "!",
+                              "fakesink", "num-buffers=5"], capture_output=True, text=True, timeout=90,
+                             env=plain_gst_env())
+        self.assertEqual(udp.returncode, 0, udp.stderr[-2000:])
+        rtsp = subprocess.run([os.environ["GST_LAUNCH"], "-q", "rtspsrc", f"location=rtsp://127.0.0.1:{rtsp_port}/cam",
+                               "!", "rtph264depay", "!", "avdec_h264", "!", "video/x-raw,width=64,height=48", "!",
+                               "fakesink", "num-buffers=5"], capture_output=True, text=True, timeout=90,
+                              env=plain_gst_env())
+        self.assertEqual(rtsp.returncode, 0, rtsp.stderr[-2000:])
+        self.assertEqual(d.stop(), 0)
+
+
 class DaemonFailures(DaemonTestCase):
     def test_failing_source_restarts_while_other_stream_runs(self):
         # Nothing listens on this port: the RTSP source fails at once, every time.

@@ -28,6 +28,7 @@ endif()
 foreach(test_case
     DaemonLifecycle.test_ready_flows_reload_and_clean_stop
     DaemonLifecycle.test_watchdog_and_status
+    DaemonVideoOut.test_rtsp_mount_and_rtp_udp_deliver_decodable_h264
     DaemonFailures.test_failing_source_restarts_while_other_stream_runs
     DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
     CheckConfig.test_valid_config_passes
