@@ -13,6 +13,7 @@
 #include "config_environment.hpp"
 #include "config_issues.hpp"
 #include "config_read.hpp"
+#include "config_text.hpp"
 #include "config_toml.hpp"
 
 namespace neuflow::daemon {
@@ -39,7 +40,7 @@ std::string ConfigIssue::to_string() const {
     text += ':' + std::to_string(line);
     if (column > 0) text += ':' + std::to_string(column);
   }
-  return text + ": " + message;
+  return text + (is_warning() ? ": warning: " : ": ") + message;
 }
 
 ConfigError::ConfigError(std::vector<ConfigIssue> issues)
@@ -61,6 +62,10 @@ Config parse_config(const std::string& text, const std::filesystem::path& file, 
     throw std::logic_error("neuflowd config: call gst_init() before checking a config against this machine");
   }
   Issues issues(file);
+  if (const auto problem = check_config_text(text)) {
+    issues.add({problem->line, problem->column}, problem->message);
+    throw ConfigError(issues.take_sorted());
+  }
   toml::table root;
   try {
     root = toml::parse(std::string_view(text), std::string_view(file.string()));
@@ -69,8 +74,18 @@ Config parse_config(const std::string& text, const std::filesystem::path& file, 
     throw ConfigError(issues.take_sorted());
   }
   ReadResult result = read_config(root, file, issues);
-  if (checks == ConfigChecks::all) check_machine(result.needs, installed_gstreamer(), issues);
-  if (!issues.empty()) throw ConfigError(issues.take_sorted());
+  std::vector<ConfigIssue> warnings;
+  if (checks == ConfigChecks::all) {
+    Issues machine(file);
+    check_machine(result.needs, installed_gstreamer(), machine);
+    warnings = machine.take_sorted();
+    for (auto& warning : warnings) warning.severity = ConfigIssue::Severity::warning;
+  }
+  if (!issues.empty()) {
+    issues.add_all(std::move(warnings));
+    throw ConfigError(issues.take_sorted());
+  }
+  result.config.warnings = std::move(warnings);
   return std::move(result.config);
 }
 

@@ -159,25 +159,34 @@ struct RtspSettings {     // [rtsp]; needed when a video sink uses `rtsp`
   bool operator==(const RtspSettings&) const = default;
 };
 
+struct ConfigIssue {
+  // An error makes the file unusable; a warning is about this machine as it is now (a camera
+  // not plugged in yet, a model not fetched yet): the stream waits for it, in backoff.
+  enum class Severity { error, warning };
+  std::filesystem::path file;
+  int line = 0;
+  int column = 0;
+  std::string message;    // what is wrong and what was expected
+  Severity severity = Severity::error;
+  bool is_warning() const { return severity == Severity::warning; }
+  std::string to_string() const;  // "FILE:LINE:COLUMN: message", "FILE:LINE:COLUMN: warning: message"
+};
+
 struct Config {
   std::filesystem::path file;         // where it was read from
   DaemonSettings daemon;
   std::optional<MetricsSettings> metrics;
   std::optional<RtspSettings> rtsp;
   std::vector<StreamConfig> streams;  // at least one
+  // What the machine lacks now (ConfigChecks::all): logged, never fatal.
+  std::vector<ConfigIssue> warnings;
 };
 
 // ---- loading -------------------------------------------------------------------------------
 
-struct ConfigIssue {
-  std::filesystem::path file;
-  int line = 0;
-  int column = 0;
-  std::string message;    // what is wrong and what was expected
-  std::string to_string() const;  // "FILE:LINE:COLUMN: message"
-};
 
-// Thrown by load_config with every issue found (not just the first).
+// Thrown by load_config with every issue found (not just the first): at least one error, and
+// the machine's warnings beside them.
 class ConfigError : public std::runtime_error {
  public:
   explicit ConfigError(std::vector<ConfigIssue> issues);
@@ -195,12 +204,16 @@ enum class ConfigChecks {
   file_only,
   // Also what the file refers to on this machine: the model file, v4l2 device nodes, input
   // files, that output directories exist or can be created, that the GStreamer elements a
-  // stream needs are installed. The caller must have called gst_init() (std::logic_error if not).
+  // stream needs are installed. These are warnings (Config::warnings), never errors: a camera
+  // that enumerates late or a model fetched after the daemon started must not keep it down.
+  // The caller must have called gst_init() (std::logic_error if not).
   all,
 };
 
 // Reads and checks a config file (see ConfigChecks). Relative paths in it are resolved against
-// the file's folder; the Config holds absolute paths. Throws ConfigError with every issue found.
+// the file's folder; the Config holds absolute paths. Throws ConfigError with every issue found
+// when there is at least one error. Bytes that are not UTF-8 text, control characters and
+// non-ASCII characters outside strings and comments are errors before TOML parsing starts.
 Config load_config(const std::filesystem::path& file, ConfigChecks checks = ConfigChecks::all);
 
 // The same from a string (tests); `file` only names it in messages, and relative paths in

@@ -62,7 +62,9 @@ int Daemon::run() {
 }
 
 void Daemon::start_stream(const StreamConfig& config) {
-  auto stream = std::make_unique<Stream>(config, threads_for(config), config_.daemon);
+  const auto carried = totals_.find(config.name);
+  auto stream = std::make_unique<Stream>(config, threads_for(config), config_.daemon,
+                                         carried == totals_.end() ? StreamTotals{} : carried->second);
   Stream& s = *stream;
   streams_[config.name] = std::move(stream);
   s.start();
@@ -83,6 +85,7 @@ void Daemon::retire(std::unique_ptr<Stream> stream, std::function<void()> then) 
         G_PRIORITY_DEFAULT,
         [](gpointer p) -> gboolean {
           auto* r = static_cast<Retired*>(p);
+          r->daemon->totals_[r->stream->name()] = r->stream->totals();
           auto& list = r->daemon->retiring_;
           list.erase(std::remove_if(list.begin(), list.end(), [&](const auto& x) { return x.get() == r->stream; }),
                      list.end());
@@ -99,6 +102,8 @@ void Daemon::apply(Config next) {
   config_ = std::move(next);
   if (!log_level_override_.empty()) config_.daemon.log_level = log_level_override_;
   set_log_level(parse_log_level(config_.daemon.log_level));
+  // What this machine lacks now; the streams concerned retry until it is there.
+  for (const ConfigIssue& warning : config_.warnings) log_warning(warning.to_string());
 
   std::map<std::string, const StreamConfig*> wanted;
   for (const StreamConfig& s : config_.streams) wanted[s.name] = &s;

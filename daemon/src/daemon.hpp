@@ -55,6 +55,7 @@ class Daemon {
   Notifier notifier_;
   std::map<std::string, std::unique_ptr<Stream>> streams_;
   std::vector<std::unique_ptr<Stream>> retiring_;  // stopping after a reload removed or changed them
+  std::map<std::string, StreamTotals> totals_;     // of retired streams, by name, for their successors
   std::unique_ptr<RtspServer> rtsp_;
   std::unique_ptr<MetricsServer> metrics_;
   std::optional<MetricsSettings> metrics_settings_;  // what metrics_ listens on

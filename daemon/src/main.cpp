@@ -31,8 +31,9 @@ int main(int argc, char** argv) {
   std::string level;
   app.add_option("-c,--config", config_file, "Config file to run")->capture_default_str();
   app.add_option("--check-config", check_file,
-                 "Check FILE (syntax, keys, types, referenced files, devices and GStreamer elements) and exit: 0 "
-                 "when it is valid, 78 with one line per problem otherwise");
+                 "Check FILE and exit: 78 with one line per error when the file itself is wrong (syntax, keys, "
+                 "types, ranges, names), else 0; what this machine lacks now (a camera, a model, an input file, a "
+                 "GStreamer element) is printed as a warning, since the daemon waits for it");
   app.add_option("--log-level", level, "error, warning, notice, info or debug; overrides [daemon] log-level");
   CLI11_PARSE(app, argc, argv);
 
@@ -43,8 +44,14 @@ int main(int argc, char** argv) {
   if (!check_file.empty()) {
     try {
       const Config config = load_config(check_file);
-      std::printf("%s: OK, %zu stream%s\n", check_file.c_str(), config.streams.size(),
+      for (const auto& warning : config.warnings) std::fprintf(stderr, "%s\n", warning.to_string().c_str());
+      std::printf("%s: OK, %zu stream%s", check_file.c_str(), config.streams.size(),
                   config.streams.size() == 1 ? "" : "s");
+      if (!config.warnings.empty()) {
+        std::printf(" (%zu warning%s: those streams wait, in backoff, until it is fixed)", config.warnings.size(),
+                    config.warnings.size() == 1 ? "" : "s");
+      }
+      std::printf("\n");
       return 0;
     } catch (const ConfigError& e) {
       print_issues(e);

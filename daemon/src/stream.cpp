@@ -73,8 +73,19 @@ const char* to_string(StreamState state) {
   return "?";
 }
 
-Stream::Stream(StreamConfig config, int threads, DaemonSettings settings)
-    : config_(std::move(config)), threads_(threads), settings_(settings), backoff_s_(settings.restart_delay_min) {}
+Stream::Stream(StreamConfig config, int threads, DaemonSettings settings, StreamTotals carried)
+    : config_(std::move(config)),
+      threads_(threads),
+      settings_(settings),
+      backoff_s_(settings.restart_delay_min),
+      base_{carried.frames_in, carried.frames_processed, carried.frames_dropped, carried.flows},
+      restarts_(carried.restarts),
+      sink_failures_(carried.sink_failures) {}
+
+StreamTotals Stream::totals() const {
+  const StreamSnapshot s = snapshot();
+  return {s.frames_in, s.frames_processed, s.frames_dropped, s.flows, s.restarts, s.sink_failures};
+}
 
 Stream::~Stream() {
   if (restart_timer_) g_source_remove(restart_timer_);
@@ -97,6 +108,11 @@ void Stream::start() {
     graph_.reset();
     fail(std::string("cannot build the pipeline: ") + e.what());
     return;
+  }
+  for (const UnbuiltSink& sink : graph_->unbuilt_sinks()) {
+    ++sink_failures_;
+    log_error("stream " + config_.name + ": sink " + sink.name + " cannot be built: " + sink.reason +
+              "; the stream goes on with its other sinks (tried again at its next restart or reload)");
   }
   GstBus* bus = gst_element_get_bus(graph_->pipeline());
   gst_bus_set_sync_handler(bus, &Stream::on_bus_sync, graph_.get(), nullptr);

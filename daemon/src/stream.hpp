@@ -35,12 +35,24 @@ struct StreamSnapshot {
   double retry_in_s = 0;               // backoff only
 };
 
+// What a stream has counted since the daemon started, carried from one Stream object to the
+// next when a reload rebuilds it, so Prometheus sees its counters reset only at process start.
+struct StreamTotals {
+  std::uint64_t frames_in = 0;
+  std::uint64_t frames_processed = 0;
+  std::uint64_t frames_dropped = 0;
+  std::uint64_t flows = 0;
+  std::uint64_t restarts = 0;
+  std::uint64_t sink_failures = 0;
+};
+
 class Stream {
  public:
   using Clock = std::chrono::steady_clock;
 
-  // `threads`: inference threads for this stream's flow element.
-  Stream(StreamConfig config, int threads, DaemonSettings settings);
+  // `threads`: inference threads for this stream's flow element; `carried`: the totals of the
+  // stream of the same name that this one replaces.
+  Stream(StreamConfig config, int threads, DaemonSettings settings, StreamTotals carried = {});
   ~Stream();
   Stream(const Stream&) = delete;
   Stream& operator=(const Stream&) = delete;
@@ -63,6 +75,7 @@ class Stream {
   // taken far longer than it may.
   bool healthy() const;
   StreamSnapshot snapshot() const;
+  StreamTotals totals() const;
   std::string status() const;  // short, for STATUS=
 
  private:

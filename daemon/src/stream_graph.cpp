@@ -355,25 +355,42 @@ std::unique_ptr<StreamGraph> build_stream_graph(const StreamConfig& config, int 
   graph->tee_ = tee;
 
   for (const SinkConfig& sink : config.sinks) {
+    // A branch is built outside the pipeline, so one that cannot be built (its folder cannot
+    // be created, an element is missing) leaves nothing behind and the other sinks still run.
     auto branch = std::make_unique<SinkBranch>();
     branch->name = sink.name;
     branch->kind = sink_kind(sink);
-    branch->bin = gst_bin_new(("sink-" + sink.name).c_str());
-    gst_bin_add(bin, branch->bin);
-    gst_object_ref(branch->bin);  // kept after a failed branch leaves the pipeline, for branch_of()
-    GstElement* first = fill_branch(GST_BIN(branch->bin), config.name, sink);
-    GstPad* first_sink = gst_element_get_static_pad(first, "sink");
-    GstPad* ghost = gst_ghost_pad_new("sink", first_sink);
-    gst_object_unref(first_sink);
-    gst_element_add_pad(branch->bin, ghost);
-    branch->tee_pad = gst_element_request_pad_simple(tee, "src_%u");
-    if (gst_pad_link(branch->tee_pad, ghost) != GST_PAD_LINK_OK) {
-      throw std::runtime_error("cannot link the tee to sink " + sink.name);
+    branch->bin = GST_ELEMENT(gst_object_ref_sink(gst_bin_new(("sink-" + sink.name).c_str())));
+    try {
+      GstElement* first = fill_branch(GST_BIN(branch->bin), config.name, sink);
+      GstPad* first_sink = gst_element_get_static_pad(first, "sink");
+      GstPad* ghost = gst_ghost_pad_new("sink", first_sink);
+      gst_object_unref(first_sink);
+      gst_element_add_pad(branch->bin, ghost);
+    } catch (const std::exception& e) {
+      gst_object_unref(branch->bin);
+      graph->unbuilt_.push_back({sink.name, e.what()});
+      continue;
     }
+    // The pipeline takes a reference of its own; ours is kept after a failed branch leaves
+    // the pipeline, for branch_of().
+    gst_bin_add(bin, branch->bin);
+    GstPad* ghost = gst_element_get_static_pad(branch->bin, "sink");
+    branch->tee_pad = gst_element_request_pad_simple(tee, "src_%u");
+    const GstPadLinkReturn linked = gst_pad_link(branch->tee_pad, ghost);
+    gst_object_unref(ghost);
+    if (linked != GST_PAD_LINK_OK) throw std::runtime_error("cannot link the tee to sink " + sink.name);
     gst_pad_add_probe(branch->tee_pad,
                       static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_BUFFER_LIST),
                       drop_when_failed, branch.get(), nullptr);
     graph->sinks_.push_back(std::move(branch));
+  }
+  if (graph->sinks_.empty()) {
+    std::string reasons;
+    for (const auto& failed : graph->unbuilt_) {
+      reasons += (reasons.empty() ? "" : "; ") + std::string("sink ") + failed.name + ": " + failed.reason;
+    }
+    throw std::runtime_error("no sink could be built (" + reasons + ")");
   }
   return graph;
 }

@@ -29,6 +29,12 @@ struct SinkBranch {
   bool removed = false;           // taken out of the pipeline after failing (main thread only)
 };
 
+// A sink that could not be built when the pipeline was; the stream runs without it.
+struct UnbuiltSink {
+  std::string name;
+  std::string reason;
+};
+
 // Owns the pipeline (one reference) and the tee pads.
 class StreamGraph {
  public:
@@ -40,6 +46,7 @@ class StreamGraph {
   GstElement* pipeline() const { return pipeline_; }
   GstElement* flow_element() const { return flow_; }
   std::vector<std::unique_ptr<SinkBranch>>& sinks() { return sinks_; }
+  const std::vector<UnbuiltSink>& unbuilt_sinks() const { return unbuilt_; }
 
   // The branch an element belongs to, or nullptr when it is outside every sink branch.
   SinkBranch* branch_of(GstObject* element);
@@ -55,6 +62,7 @@ class StreamGraph {
   GstElement* flow_ = nullptr;
   GstElement* tee_ = nullptr;
   std::vector<std::unique_ptr<SinkBranch>> sinks_;
+  std::vector<UnbuiltSink> unbuilt_;
 };
 
 // The intervideo channel that carries a stream's visualization to an RTSP mount.
@@ -62,7 +70,9 @@ std::string rtsp_channel_name(const std::string& stream, const std::string& moun
 
 // Builds the pipeline in NULL state. `threads` is the inference threads this stream gets;
 // `instance` names the pipeline ("front" or "front#3" after restarts) in GStreamer's logs.
-// Throws std::runtime_error naming the element that could not be made.
+// A sink that cannot be built is left out and listed in unbuilt_sinks(); throws
+// std::runtime_error naming the element or sink when the source, the flow stage or every sink
+// cannot be built.
 std::unique_ptr<StreamGraph> build_stream_graph(const StreamConfig& config, int threads, const std::string& instance);
 
 // The first index not used yet by files matching printf-style `pattern` ("…%05d…") in its

@@ -53,6 +53,7 @@
 #include <string>
 #include <system_error>
 
+#include "earlier_files.hpp"
 #include "elements.hpp"
 #include "flow_index_compaction.hpp"
 #include "neuflow/flow/errors.hpp"
@@ -261,6 +262,34 @@ static void gst_neuflow_sink_finalize(GObject *object) {
   G_OBJECT_CLASS(gst_neuflow_sink_parent_class)->finalize(object);
 }
 
+// What earlier runs left: the temporaries of writes a crash interrupted go, and with a limit
+// set, the files the pattern names count towards it (oldest index first), so a restarted or
+// reconfigured stream holds max-files / max-bytes over everything in the folder.
+static void gst_neuflow_sink_take_over_earlier_files(GstNeuflowSink *self) {
+  for (const std::string &path : neuflow::gst::remove_stale_temporaries(self->pattern, self->index_path ? self->index_path : "")) {
+    GST_INFO_OBJECT(self, "removed %s, left by an interrupted write", path.c_str());
+  }
+  GST_OBJECT_LOCK(self);
+  const guint64 max_files = self->max_files;
+  const guint64 max_bytes = self->max_bytes;
+  GST_OBJECT_UNLOCK(self);
+  if (max_files == 0 && max_bytes == 0) return;
+  for (const auto &file : neuflow::gst::files_matching(self->pattern)) self->written->add(file.path, file.bytes);
+  for (const std::string &old : self->written->take_excess(max_files, max_bytes)) {
+    ++self->files_removed;  // the index is compacted at the latest when the sink stops
+    if (std::remove(old.c_str()) != 0 && errno != ENOENT) {
+      const int err = errno;
+      GST_ELEMENT_WARNING(self, RESOURCE, WRITE,
+                          ("Could not delete the old flow file \"%s\" (max-files=%" G_GUINT64_FORMAT
+                           ", max-bytes=%" G_GUINT64_FORMAT "): %s.",
+                           old.c_str(), max_files, max_bytes, g_strerror(err)),
+                          (nullptr));
+    } else {
+      GST_LOG_OBJECT(self, "deleted %s, left by an earlier run", old.c_str());
+    }
+  }
+}
+
 // Validates the settings and checks that the output directories exist, so that a typo shows
 // up when the pipeline starts rather than at the first flow. Files are created only when
 // there is flow to write.
@@ -319,6 +348,7 @@ static gboolean gst_neuflow_sink_start(GstBaseSink *sink) {
   self->pattern = g_steal_pointer(&location);
   self->index_path = g_steal_pointer(&index_path);
   self->index_dir = g_steal_pointer(&index_dir);
+  gst_neuflow_sink_take_over_earlier_files(self);
   return TRUE;
 }
 

@@ -13,6 +13,7 @@ Run one test: e2e_test.py DaemonLifecycle.test_ready_flows_reload_and_clean_stop
 import os
 import queue
 import re
+import resource
 import shutil
 import signal
 import socket
@@ -83,7 +84,7 @@ class NotifySocket:
 
 
 class Daemon:
-    def __init__(self, folder, config_text, extra_env=None):
+    def __init__(self, folder, config_text, extra_env=None, max_open_files=None):
         self.folder = folder
         self.config = os.path.join(folder, "neuflowd.toml")
         with open(self.config, "w") as f:
@@ -94,8 +95,12 @@ class Daemon:
         env["NOTIFY_SOCKET"] = self.notify.path
         env.update(extra_env or {})
         self.log = open(self.log_path, "w")
+        def limit_files():
+            if max_open_files:
+                resource.setrlimit(resource.RLIMIT_NOFILE, (max_open_files, max_open_files))
+
         self.proc = subprocess.Popen([os.environ["NEUFLOWD"], "--config", self.config, "--log-level", "debug"],
-                                     stdout=self.log, stderr=subprocess.STDOUT, env=env)
+                                     stdout=self.log, stderr=subprocess.STDOUT, env=env, preexec_fn=limit_files)
 
     def rewrite(self, config_text):
         tmp = self.config + ".new"
@@ -294,6 +299,31 @@ class DaemonLifecycle(DaemonTestCase):
         self.assertEqual(d.stop(), 0)
 
 
+def scrape(port):
+    return urllib.request.urlopen(f"http://127.0.0.1:{port}/metrics", timeout=10).read().decode()
+
+
+def metric(body, name, stream):
+    m = re.search(name + r'\{stream="' + stream + r'"\} (\d+)', body)
+    assert m, f"no {name} for {stream} in:\n{body}"
+    return int(m.group(1))
+
+
+def wait_until(predicate, timeout, what):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return
+        time.sleep(0.2)
+    raise AssertionError(f"{what} within {timeout} s")
+
+
+def make_clip(path, frames=12):
+    subprocess.run([os.environ["GST_LAUNCH"], "-q", "videotestsrc", f"num-buffers={frames}", "pattern=ball", "!",
+                    "video/x-raw,width=64,height=48,framerate=10/1", "!", "x264enc", "!", "mp4mux", "!",
+                    "filesink", f"location={path}"], check=True, timeout=60, env=plain_gst_env())
+
+
 def free_port(kind=socket.SOCK_STREAM):
     s = socket.socket(socket.AF_INET, kind)
     s.bind(("127.0.0.1", 0))
@@ -408,15 +438,145 @@ class CheckConfig(DaemonTestCase):
         line = next(i for i, l in enumerate(text.splitlines(), 1) if "colour" in l)
         self.assertRegex(out.stderr, re.escape(path) + f":{line}:\\d+: .*colour")
 
-    def test_missing_model_is_reported_at_start_too(self):
-        text = stream_block("bad", test_source(), ['  type = "files"\n  directory = "%s"' %
-                                                   os.path.join(self.dir, "x")]).replace(CHECKPOINT, "/nonexistent.pth")
+    def test_missing_model_is_a_warning_and_the_stream_waits_for_it(self):
+        model = os.path.join(self.dir, "models", "late.pth")
+        text = ('[daemon]\nrestart-delay-min = 0.5\nrestart-delay-max = 1.0\n' +
+                stream_block("late", test_source(), ['  type = "files"\n  directory = "%s"' %
+                                                     os.path.join(self.dir, "x")]).replace(CHECKPOINT, model))
         out, _ = self.run_check(text)
-        self.assertEqual(out.returncode, 78)
-        self.assertIn("/nonexistent.pth", out.stderr)
+        self.assertEqual(out.returncode, 0, out.stderr)
+        self.assertRegex(out.stderr, r":\d+:\d+: warning: model: .*late\.pth.* does not exist")
+        self.assertIn("1 warning", out.stdout)
         d = self.start(text)
-        self.assertEqual(d.proc.wait(timeout=60), 78)
-        self.assertIn("/nonexistent.pth", d.log_text())
+        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_log(r"warning: model: .*late\.pth", timeout=10)
+        d.wait_log(r"stream late: .*restarting in", timeout=60)
+        # The model arrives (fetch-model, a copy): the stream comes up by itself.
+        os.makedirs(os.path.dirname(model))
+        shutil.copy(CHECKPOINT, model)
+        wait_until(lambda: len(flow_files(os.path.join(self.dir, "x"))) >= 2, 60, "no flows once the model arrived")
+        self.assertEqual(d.stop(), 0, d.log_text()[-3000:])
+
+
+class DaemonReliability(DaemonTestCase):
+    def test_missing_camera_and_input_file_leave_the_other_streams_running(self):
+        clip = os.path.join(self.dir, "arrives-later.mp4")
+        good = os.path.join(self.dir, "good")
+        late = os.path.join(self.dir, "late")
+        metrics_port = free_port()
+        text = (f'[daemon]\nrestart-delay-min = 0.5\nrestart-delay-max = 1.0\n'
+                f'[metrics]\nlisten = "127.0.0.1:{metrics_port}"\n' +
+                stream_block("cam", '  type = "v4l2"\n  device = "/dev/video99"',
+                             ['  type = "files"\n  directory = "%s"' % os.path.join(self.dir, "cam")]) +
+                stream_block("late", f'  type = "uri"\n  path = "{clip}"', [f'  type = "files"\n  directory = "{late}"'],
+                             behaviour="every-pair") +
+                stream_block("good", test_source(), [f'  type = "files"\n  directory = "{good}"']))
+        path = os.path.join(self.dir, "check.toml")
+        with open(path, "w") as f:
+            f.write(text)
+        check = subprocess.run([os.environ["NEUFLOWD"], "--check-config", path], capture_output=True, text=True,
+                               timeout=60)
+        self.assertEqual(check.returncode, 0, check.stderr)
+        self.assertRegex(check.stderr, r"warning: device: \"/dev/video99\" does not exist")
+        self.assertRegex(check.stderr, r"warning: path: .*arrives-later\.mp4")
+
+        d = self.start(text)
+        d.notify.wait_for("READY=1", timeout=60)
+        wait_until(lambda: len(flow_files(good)) >= 3, 60, "the good stream wrote no flows")
+        d.wait_log(r"stream cam: .*restarting in", timeout=30)
+        d.wait_log(r"stream late: .*restarting in", timeout=30)
+
+        # A reload while the camera is still missing is accepted.
+        d.proc.send_signal(signal.SIGHUP)
+        d.notify.wait_for("RELOADING=1", timeout=30)
+        d.notify.wait_for("READY=1", timeout=60)
+        self.assertNotIn("the new config has errors", d.log_text())
+
+        # The input file appears: its stream comes up and converts every pair.
+        make_clip(clip + ".part")
+        os.replace(clip + ".part", clip)
+        d.wait_log(r"stream late: end of input", timeout=90)
+        self.assertEqual(len(flow_files(late)), 11, d.log_text()[-3000:])
+        body = scrape(metrics_port)
+        self.assertGreaterEqual(metric(body, "neuflow_stream_restarts_total", "cam"), 2)
+        before = len(flow_files(good))
+        wait_until(lambda: len(flow_files(good)) > before, 30, "the good stream stopped")
+        self.assertEqual(d.stop(), 0, d.log_text()[-3000:])
+
+    def test_a_sink_that_cannot_be_built_is_cut_off_at_start(self):
+        kept = os.path.join(self.dir, "kept")
+        d = self.start(stream_block("s", test_source(), [
+            '  type = "files"\n  name = "forbidden"\n  directory = "/proc/neuflow-forbidden"',
+            f'  type = "files"\n  name = "kept"\n  directory = "{kept}"',
+        ]))
+        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_log(r"stream s: sink forbidden cannot be built: .*other sinks", timeout=30)
+        wait_until(lambda: len(flow_files(kept)) >= 5, 60, "the healthy sink wrote no flows")
+        self.assertNotIn("restarting in", d.log_text())
+        self.assertEqual(d.stop(), 0)
+
+    def test_a_flood_of_idle_metrics_connections_starves_nothing(self):
+        files = os.path.join(self.dir, "flows")
+        metrics_port = free_port()
+        d = self.start(f'[metrics]\nlisten = "127.0.0.1:{metrics_port}"\n' +
+                       stream_block("s", test_source(), [
+                           f'  type = "files"\n  name = "a"\n  directory = "{files}"',
+                           f'  type = "files"\n  name = "b"\n  directory = "{files}-b"']),
+                       max_open_files=256)
+        d.notify.wait_for("READY=1", timeout=60)
+        wait_until(lambda: len(flow_files(files)) >= 2, 60, "no flows")
+        flood = []
+        try:
+            for _ in range(400):  # more than the daemon's whole descriptor limit
+                c = socket.socket()
+                c.settimeout(2)
+                try:
+                    c.connect(("127.0.0.1", metrics_port))
+                except OSError:
+                    c.close()
+                    continue
+                flood.append(c)
+            time.sleep(1.0)
+            before = len(flow_files(files))
+            wait_until(lambda: len(flow_files(files)) >= before + 5, 30, "flows stopped during the flood")
+            self.assertIn("neuflow_frames_processed_total", scrape(metrics_port))
+        finally:
+            for c in flood:
+                c.close()
+        log = d.log_text()
+        self.assertNotIn("Too many open files", log)
+        self.assertNotIn("sink a failed", log)
+        self.assertEqual(d.stop(), 0, log[-3000:])
+
+    def test_reload_keeps_counters_and_retention_counts_earlier_files(self):
+        files = os.path.join(self.dir, "flows")
+        metrics_port = free_port()
+
+        def config(max_files):
+            return (f'[metrics]\nlisten = "127.0.0.1:{metrics_port}"\n' +
+                    stream_block("s", test_source(fps=30), [
+                        f'  type = "files"\n  directory = "{files}"\n  max-files = {max_files}']))
+
+        d = self.start(config(20))
+        d.notify.wait_for("READY=1", timeout=60)
+        wait_until(lambda: len(flow_files(files)) >= 20, 60, "fewer than 20 flows")
+        before = scrape(metrics_port)
+        processed = metric(before, "neuflow_frames_processed_total", "s")
+        self.assertGreater(processed, 20)
+
+        d.rewrite(config(10))
+        d.proc.send_signal(signal.SIGHUP)
+        d.notify.wait_for("RELOADING=1", timeout=30)
+        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_log(r"stream s: settings changed", timeout=10)
+        d.wait_log(r"stream s: playing(.*\n)+.*stream s: playing", timeout=30)
+        time.sleep(1.0)
+        self.assertLessEqual(len(flow_files(files)), 11, "max-files = 10 left earlier runs' files")
+        after = scrape(metrics_port)
+        for name in ("neuflow_frames_processed_total", "neuflow_frames_in_total", "neuflow_flows_total"):
+            self.assertGreaterEqual(metric(after, name, "s"), metric(before, name, "s"), name)
+        self.assertEqual(d.stop(), 0)
+        self.assertLessEqual(len(flow_files(files)), 10)
 
 
 if __name__ == "__main__":

@@ -33,7 +33,11 @@ foreach(test_case
     DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
     CheckConfig.test_valid_config_passes
     CheckConfig.test_errors_name_line_and_exit_78
-    CheckConfig.test_missing_model_is_reported_at_start_too)
+    CheckConfig.test_missing_model_is_a_warning_and_the_stream_waits_for_it
+    DaemonReliability.test_missing_camera_and_input_file_leave_the_other_streams_running
+    DaemonReliability.test_a_sink_that_cannot_be_built_is_cut_off_at_start
+    DaemonReliability.test_a_flood_of_idle_metrics_connections_starves_nothing
+    DaemonReliability.test_reload_keeps_counters_and_retention_counts_earlier_files)
   add_test(NAME daemon.e2e.${test_case}
            COMMAND ${NEUFLOW_E2E_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/e2e_test.py -v ${test_case})
   set_tests_properties(daemon.e2e.${test_case} PROPERTIES LABELS "daemon;e2e" ENVIRONMENT "${e2e_env}"

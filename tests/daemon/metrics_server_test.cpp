@@ -9,9 +9,11 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "metrics_server.hpp"
 #include "prometheus_text.hpp"
@@ -393,6 +395,46 @@ TEST(MetricsServer, DestroyingItClosesConnectedClients) {
   // The port is free again: a restarted daemon can listen there at once.
   MetricsServer again("127.0.0.1", port, [] { return std::string("y 1\n"); });
   EXPECT_EQ(fetch("GET", again.url()).body, "y 1\n");
+}
+
+// A flood of idle connections (1,027 of them once used up the daemon's descriptors, and its
+// file sinks failed): the server keeps at most max_connections, closing the oldest, and a
+// scrape that comes after the flood is still answered.
+TEST(MetricsServer, ConnectionsBeyondTheCapCloseTheOldestAndScrapesStillAnswer) {
+  MetricsServer::Limits limits;
+  limits.max_connections = 4;
+  MetricsServer server("127.0.0.1", 0, [] { return std::string("x 1\n"); }, limits);
+  const size_t before = open_descriptors();
+  std::vector<std::unique_ptr<RawClient>> flood;
+  for (int i = 0; i < 40; ++i) {
+    flood.push_back(std::make_unique<RawClient>(server.port()));
+    iterate_for(2ms);
+  }
+  EXPECT_TRUE(iterate_until([&] { return server.open_connections() <= 4; }, 2000ms)) << server.open_connections();
+  // Each client end is one descriptor of this process; the server's ends stay within its cap.
+  EXPECT_LE(open_descriptors(), before + 40 + 4 + 2);
+  std::string received;
+  EXPECT_TRUE(flood.front()->wait_closed(received)) << "the oldest idle connection was kept open";
+  const Response r = fetch("GET", server.url());
+  EXPECT_EQ(r.status, 200u) << r.error;
+  EXPECT_EQ(r.body, "x 1\n");
+  EXPECT_LE(server.open_connections(), 4u);
+}
+
+TEST(MetricsServer, AConnectionThatSaysNothingIsClosedAfterTheIdleTimeout) {
+  MetricsServer::Limits limits;
+  limits.idle_timeout = 1000ms;
+  MetricsServer server("127.0.0.1", 0, [] { return std::string("x 1\n"); }, limits);
+  RawClient silent(server.port());
+  RawClient halfway(server.port());
+  halfway.send("GET /metrics HTTP/1.1\r\nHost: 127.0.0.1\r\n");  // and never the blank line
+  std::string received;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(silent.wait_closed(received, 4000ms)) << "an idle connection stayed open";
+  EXPECT_TRUE(halfway.wait_closed(received, 4000ms)) << "a stalled request stayed open";
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 900ms) << "closed before its timeout";
+  EXPECT_TRUE(iterate_until([&] { return server.open_connections() == 0; }, 2000ms));
+  EXPECT_EQ(fetch("GET", server.url()).status, 200u);
 }
 
 }  // namespace
