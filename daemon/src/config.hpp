@@ -95,6 +95,7 @@ struct FilesSink {        // type = "files"
 struct ShmSink {          // type = "shm"
   std::string name;       // POSIX shm name, e.g. "/neuflow-front" (required, leading '/')
   int slots = 4;          // the latest N flows
+  unsigned mode = 0640;   // shm-mode = "0640" (or 0o640): the segment's permissions
   bool operator==(const ShmSink&) const = default;
 };
 
@@ -154,8 +155,10 @@ struct MetricsSettings {  // [metrics]; absent: no endpoint
 };
 
 struct RtspSettings {     // [rtsp]; needed when a video sink uses `rtsp`
-  std::string address = "0.0.0.0";    // listen = "0.0.0.0:8554"
+  std::string address = "127.0.0.1";  // listen = "127.0.0.1:8554"; "0.0.0.0:8554" for the network
   int port = 8554;
+  std::filesystem::path credentials;  // credentials = "/etc/neuflow/rtsp-users": user:password lines
+  std::string auth = "digest";        // auth = "digest" | "basic" (with credentials)
   bool operator==(const RtspSettings&) const = default;
 };
 

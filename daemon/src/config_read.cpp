@@ -38,8 +38,6 @@ DaemonSettings read_daemon(const TableReader& t) {
 
 // `listen = "host:port"` of [metrics] and [rtsp]; false when it is malformed.
 bool read_listen(const TableReader& t, std::string& address, int& port) {
-  static constexpr std::array<std::string_view, 1> keys = {"listen"};
-  t.allow_only(keys);
   const auto text = t.string("listen");
   if (!text) return !t.has("listen");
   std::string error;
@@ -97,12 +95,31 @@ ReadResult read_config(const toml::table& root_table, const std::filesystem::pat
     config.daemon = read_daemon(TableReader(*t, "[daemon]", issues));
   if (const auto* t = root.table("metrics", Need::optional)) {
     MetricsSettings m;
-    if (read_listen(TableReader(*t, "[metrics]", issues), m.address, m.port)) config.metrics = m;
+    const TableReader reader(*t, "[metrics]", issues);
+    static constexpr std::array<std::string_view, 1> metrics_keys = {"listen"};
+    reader.allow_only(metrics_keys);
+    if (read_listen(reader, m.address, m.port)) config.metrics = m;
   }
   if (const auto* t = root.table("rtsp", Need::optional)) {
     RtspSettings r;
     const TableReader reader(*t, "[rtsp]", issues);
-    if (read_listen(reader, r.address, r.port)) config.rtsp = r;
+    static constexpr std::array<std::string_view, 3> rtsp_keys = {"listen", "credentials", "auth"};
+    static constexpr std::array<std::string_view, 2> auth_methods = {"digest", "basic"};
+    reader.allow_only(rtsp_keys);
+    bool valid = read_listen(reader, r.address, r.port);
+    if (auto users = reader.string("credentials")) {
+      r.credentials = context.need_path(PathNeed::Kind::readable_file, *users, "credentials",
+                                        reader.position("credentials"));
+    } else if (reader.has("credentials")) {
+      valid = false;
+    }
+    if (auto method = reader.choice("auth", auth_methods)) {
+      r.auth = *method;
+      if (r.credentials.empty()) reader.report("auth", "needs credentials = \"FILE\" (user:password lines) beside it");
+    } else if (reader.has("auth")) {
+      valid = false;
+    }
+    if (valid) config.rtsp = r;
     // A malformed [rtsp] still counts as present, so its video sinks are not reported too.
     context.has_rtsp_server = true;
     if (config.rtsp && config.metrics && config.rtsp->port == config.metrics->port &&

@@ -40,7 +40,7 @@ FilesSink read_files(const TableReader& t, const std::string& user, ReadContext&
 }
 
 ShmSink read_shm(const TableReader& t, const std::string& user, ReadContext& context) {
-  static constexpr std::array<std::string_view, 4> keys = {"type", "name", "shm-name", "slots"};
+  static constexpr std::array<std::string_view, 5> keys = {"type", "name", "shm-name", "slots", "shm-mode"};
   t.allow_only(keys);
   ShmSink s;
   if (auto name = t.string("shm-name", Need::required)) {
@@ -52,6 +52,18 @@ ShmSink read_shm(const TableReader& t, const std::string& user, ReadContext& con
     }
   }
   if (auto v = t.integer("slots", 1, 64)) s.slots = static_cast<int>(*v);
+  if (const auto* node = t.get("shm-mode")) {
+    std::optional<unsigned> mode;
+    if (const auto* text = node->as_string()) mode = parse_octal_mode(text->get());
+    if (const auto* number = node->as_integer(); number && number->get() >= 0 && number->get() <= 07777) {
+      mode = static_cast<unsigned>(number->get());
+    }
+    if (mode && check_shm_mode(*mode).empty()) {
+      s.mode = *mode;
+    } else {
+      t.report("shm-mode", "expected " + check_shm_mode(07777) + ", got " + describe_value(*node));
+    }
+  }
   return s;
 }
 

@@ -72,6 +72,24 @@ std::string check_shm_name(std::string_view name) {
   return {};
 }
 
+std::string check_shm_mode(unsigned mode) {
+  // The rule of neuflowshmsink's shm-mode, which refuses anything else at start.
+  if ((mode & ~0666u) != 0 || (mode & 0600u) != 0600u) {
+    return "an octal mode like \"0640\" (or 0o640) with read/write bits only, at least 0600 and at most 0666";
+  }
+  return {};
+}
+
+std::optional<unsigned> parse_octal_mode(std::string_view text) {
+  if (text.size() < 3 || text.size() > 4) return std::nullopt;
+  unsigned mode = 0;
+  for (const char c : text) {
+    if (c < '0' || c > '7') return std::nullopt;
+    mode = mode * 8 + static_cast<unsigned>(c - '0');
+  }
+  return mode;
+}
+
 std::string check_rtsp_mount(std::string_view mount) {
   const std::string expected = "a mount point like \"/front\": '/' then A-Z a-z 0-9 . _ - and '/' between parts";
   if (mount.size() < 2 || mount.front() != '/' || mount.back() == '/') return expected;

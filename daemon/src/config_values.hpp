@@ -23,6 +23,11 @@ std::optional<HostPort> parse_host_port(std::string_view text, std::string& erro
 // A POSIX shared-memory object name: "/name", no further '/'.
 std::string check_shm_name(std::string_view name);
 
+// The permissions of a shared-memory ring: read/write bits only, the owner's included.
+std::string check_shm_mode(unsigned mode);
+// "0640" / "640" → 0640; nothing when it is not 3 or 4 octal digits.
+std::optional<unsigned> parse_octal_mode(std::string_view text);
+
 // An RTSP server mount point: "/front", "/cameras/front".
 std::string check_rtsp_mount(std::string_view mount);
 

@@ -9,6 +9,7 @@
 #include "log.hpp"
 #include "metrics_server.hpp"
 #include "prometheus_text.hpp"
+#include "rtsp_credentials.hpp"
 #include "rtsp_server.hpp"
 
 namespace neuflow::daemon {
@@ -143,9 +144,18 @@ void Daemon::apply(Config next) {
 void Daemon::update_servers() {
   const auto mounts = rtsp_mounts(config_);
   if (rtsp_ && (!config_.rtsp || !(rtsp_->settings() == *config_.rtsp))) rtsp_.reset();
+  if (rtsp_) {
+    try {
+      rtsp_->reload_credentials();  // a reload is how users are added or removed
+    } catch (const RtspCredentialsError& e) {
+      log_error(std::string(e.what()) + "; the RTSP users stay as they were");
+    }
+  }
   if (!rtsp_ && config_.rtsp && !mounts.empty()) {
     try {
       rtsp_ = std::make_unique<RtspServer>(*config_.rtsp);
+    } catch (const RtspCredentialsError& e) {
+      log_error(std::string(e.what()) + "; no RTSP mount is served until it can be read (fix it and reload)");
     } catch (const std::exception& e) {
       log_error(std::string(e.what()) + "; the streams run without their RTSP mounts");
     }

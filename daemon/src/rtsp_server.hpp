@@ -9,6 +9,7 @@
 #include "config.hpp"
 
 typedef struct _GstRTSPServer GstRTSPServer;
+typedef struct _GstRTSPAuth GstRTSPAuth;
 
 namespace neuflow::daemon {
 
@@ -20,7 +21,9 @@ struct RtspMount {
 
 class RtspServer {
  public:
-  // Listens at once on the default main context; throws std::runtime_error when it cannot.
+  // Listens at once on the default main context; throws std::runtime_error when it cannot,
+  // RtspCredentialsError when settings.credentials is set and cannot be read (a server that
+  // was asked for authentication never serves without it).
   explicit RtspServer(const RtspSettings& settings);
   ~RtspServer();
   RtspServer(const RtspServer&) = delete;
@@ -28,10 +31,15 @@ class RtspServer {
 
   // Makes the served mounts exactly these (path → mount).
   void set_mounts(const std::map<std::string, RtspMount>& mounts);
+  // Reads the credentials file again (at a reload); on failure the users stay as they were
+  // and RtspCredentialsError says why.
+  void reload_credentials();
   int port() const;
   const RtspSettings& settings() const { return settings_; }
 
  private:
+  GstRTSPAuth* make_auth() const;  // nullptr without credentials
+
   RtspSettings settings_;
   GstRTSPServer* server_ = nullptr;
   unsigned source_id_ = 0;

@@ -177,6 +177,7 @@ GstElement* fill_branch(GstBin* bin, const std::string& stream, const SinkConfig
     GstElement* out = no_preroll(make("neuflowshmsink", p + "shm"));
     set(out, "shm-name", s->name);
     set(out, "slots", std::to_string(s->slots));
+    set(out, "shm-mode", std::to_string(s->mode));
     add_chain(bin, {q, out});
     return q;
   }

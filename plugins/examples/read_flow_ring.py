@@ -69,8 +69,9 @@ class FlowRing:
             raise RingError(f'flow ring "{name}": no such shared-memory segment (is the writer running?)',
                             retryable=True) from None
         except PermissionError:
-            raise RingError(f'flow ring "{name}": permission denied (the writer creates it with mode 0640: '
-                            "readers must run as its user or group)") from None
+            raise RingError(f'flow ring "{name}": permission denied (the writer\'s shm-mode is 0640 by default: run '
+                            "the reader as the writer's user or in its group, which is 'neuflow' under neuflowd's "
+                            "systemd units, or give the writer shm-mode=0644)") from None
         try:
             size = os.fstat(fd).st_size
             if size < HEADER.size:

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cerrno>
 #include <climits>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <optional>
@@ -78,10 +79,23 @@ std::optional<std::string> check_flow_ring_name(std::string_view name) {
   return std::nullopt;
 }
 
-FlowRingWriter::FlowRingWriter(std::string name, std::uint32_t slots, std::uint64_t first_generation)
-    : name_(std::move(name)), slots_(slots), generation_(first_generation) {
+std::optional<std::string> check_flow_ring_mode(mode_t mode) {
+  if ((mode & ~static_cast<mode_t>(0666)) != 0) {
+    return "only read and write permission bits are allowed (at most 0666), no execute, setuid, setgid or sticky bits";
+  }
+  if ((mode & 0600) != 0600) return "the owner must keep read and write permission (at least 0600)";
+  return std::nullopt;
+}
+
+FlowRingWriter::FlowRingWriter(std::string name, std::uint32_t slots, std::uint64_t first_generation, mode_t mode)
+    : name_(std::move(name)), slots_(slots), mode_(mode), generation_(first_generation) {
   if (auto problem = check_flow_ring_name(name_)) {
     throw FlowRingError("invalid shared-memory name \"" + name_ + "\": " + *problem);
+  }
+  if (auto problem = check_flow_ring_mode(mode_)) {
+    char octal[16];
+    std::snprintf(octal, sizeof octal, "%04o", static_cast<unsigned>(mode_));
+    throw FlowRingError("flow ring \"" + name_ + "\": invalid mode " + octal + ": " + *problem);
   }
   if (slots_ == 0) throw FlowRingError("flow ring \"" + name_ + "\": needs at least one slot");
   segment_ = create_segment(sizeof(ring::RingHeader));
@@ -118,7 +132,7 @@ FlowRingWriter::Segment FlowRingWriter::create_segment(std::uint64_t size) {
   // Always a new segment (O_EXCL), never a resized old one: readers mapping the old one keep
   // a valid mapping instead of faulting on pages that a shrink took away.
   Segment s;
-  s.fd = ::shm_open(name_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kFlowRingMode);
+  s.fd = ::shm_open(name_.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, mode_);
   if (s.fd < 0) {
     const int err = errno;
     if (err == EEXIST) fail("another writer created it at the same moment", 0);
@@ -131,7 +145,7 @@ FlowRingWriter::Segment FlowRingWriter::create_segment(std::uint64_t size) {
   };
   if (::flock(s.fd, LOCK_EX | LOCK_NB) != 0) cleanup_fail("cannot lock the new segment", errno);
   // shm_open applies the umask to the mode; the documented mode is the one readers rely on.
-  if (::fchmod(s.fd, kFlowRingMode) != 0) cleanup_fail("cannot set the segment's mode", errno);
+  if (::fchmod(s.fd, mode_) != 0) cleanup_fail("cannot set the segment's mode", errno);
   if (::ftruncate(s.fd, static_cast<off_t>(size)) != 0) {
     cleanup_fail("cannot size the segment to " + std::to_string(size) + " bytes", errno);
   }

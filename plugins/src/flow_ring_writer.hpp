@@ -14,8 +14,13 @@
 
 namespace neuflow::gst {
 
-// Readers run as the writer's user or in its group; others cannot read the flow.
+// The segment's default mode: readers run as the writer's user or in its group (neuflowd's
+// units make that the fixed group `neuflow`, which reader accounts join); others cannot read.
 inline constexpr mode_t kFlowRingMode = 0640;
+
+// Why `mode` cannot be a flow ring's mode, or nullopt: read and write bits only (no execute,
+// setuid, setgid or sticky bits), and the owner must be able to read and write.
+std::optional<std::string> check_flow_ring_mode(mode_t mode);
 
 // Why `name` cannot name a POSIX shared-memory segment ("/name": a leading slash, no other,
 // at most 255 characters), or nullopt.
@@ -45,7 +50,9 @@ class FlowRingWriter {
   // generation is `first_generation`, or one more than that of a replaced stale segment if
   // larger; each later segment gets the next. Throws FlowRingError naming the segment and
   // the reason.
-  FlowRingWriter(std::string name, std::uint32_t slots, std::uint64_t first_generation);
+  // Every segment gets `mode` exactly (whatever the umask), see check_flow_ring_mode.
+  FlowRingWriter(std::string name, std::uint32_t slots, std::uint64_t first_generation,
+                 mode_t mode = kFlowRingMode);
   // Marks the segment closed and unlinks the name (if it still names this segment); readers
   // that have it mapped keep reading the flows it holds.
   ~FlowRingWriter();
@@ -82,6 +89,7 @@ class FlowRingWriter {
 
   std::string name_;
   std::uint32_t slots_;
+  mode_t mode_;
   std::uint64_t generation_ = 0;
   std::uint64_t published_ = 0;
   std::uint32_t width_ = 0, height_ = 0;  // 0 × 0: the placeholder

@@ -10,8 +10,9 @@
  * and a header-only C++ reader are in `neuflow/flow_ring.hpp`; docs/shm-ring.md describes
  * them and a Python reader.
  *
- * The segment is created (mode 0640: readers run as the pipeline's user or in its group)
- * when the element starts, as a placeholder that readers see as "not ready", and sized for
+ * The segment is created with #neuflowshmsink:shm-mode (0640 by default: readers run as the
+ * pipeline's user or in its group; neuflowd's systemd units run with the fixed group
+ * `neuflow` for that, which reader accounts join) when the element starts, as a placeholder that readers see as "not ready", and sized for
  * the flow grid at the first flow. When the grid size changes the writer creates a new
  * segment under the same name with the next `generation` and marks the old one closed, which
  * tells readers to open the name again. When the element stops it marks the segment closed
@@ -48,12 +49,14 @@ enum {
   PROP_0,
   PROP_SHM_NAME,
   PROP_SLOTS,
+  PROP_SHM_MODE,
   PROP_FLOWS_WRITTEN,
   PROP_BUFFERS_SKIPPED,
 };
 
 #define DEFAULT_SLOTS 4
 #define MAX_SLOTS 64
+#define DEFAULT_SHM_MODE 0640
 
 struct GstNeuflowShmSink {
   GstBaseSink parent;
@@ -61,6 +64,7 @@ struct GstNeuflowShmSink {
   // Properties, under the object lock.
   gchar *shm_name;
   guint slots;
+  guint shm_mode;
   guint64 flows_written;
   guint64 buffers_skipped;
 
@@ -98,6 +102,9 @@ static void gst_neuflow_shm_sink_set_property(GObject *object, guint prop_id, co
     case PROP_SLOTS:
       self->slots = g_value_get_uint(value);
       break;
+    case PROP_SHM_MODE:
+      self->shm_mode = g_value_get_uint(value);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -114,6 +121,9 @@ static void gst_neuflow_shm_sink_get_property(GObject *object, guint prop_id, GV
       break;
     case PROP_SLOTS:
       g_value_set_uint(value, self->slots);
+      break;
+    case PROP_SHM_MODE:
+      g_value_set_uint(value, self->shm_mode);
       break;
     case PROP_FLOWS_WRITTEN:
       g_value_set_uint64(value, self->flows_written);
@@ -150,6 +160,7 @@ static gboolean gst_neuflow_shm_sink_start(GstBaseSink *sink) {
   GST_OBJECT_LOCK(self);
   g_autofree gchar *name = g_strdup(self->shm_name);
   const guint slots = self->slots;
+  const auto mode = static_cast<mode_t>(self->shm_mode);
   self->flows_written = 0;
   self->buffers_skipped = 0;
   GST_OBJECT_UNLOCK(self);
@@ -164,16 +175,22 @@ static gboolean gst_neuflow_shm_sink_start(GstBaseSink *sink) {
     return FALSE;
   }
 
+  if (auto problem = neuflow::gst::check_flow_ring_mode(mode)) {
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Invalid shm-mode %04o: %s.", static_cast<unsigned>(mode), problem->c_str()),
+                      (nullptr));
+    return FALSE;
+  }
+
   gst_neuflow_shm_sink_close(self);
   try {
-    self->writer = new neuflow::gst::FlowRingWriter(name, slots, self->next_generation);
+    self->writer = new neuflow::gst::FlowRingWriter(name, slots, self->next_generation, mode);
   } catch (const std::exception &e) {
     GST_ELEMENT_ERROR(self, RESOURCE, OPEN_WRITE, ("Could not create the shared-memory flow ring: %s.", e.what()),
                       (nullptr));
     return FALSE;
   }
-  GST_INFO_OBJECT(self, "flow ring %s with %u slots, generation %" G_GUINT64_FORMAT, name, slots,
-                  self->writer->generation());
+  GST_INFO_OBJECT(self, "flow ring %s with %u slots, mode %04o, generation %" G_GUINT64_FORMAT, name, slots,
+                  static_cast<unsigned>(mode), self->writer->generation());
   return TRUE;
 }
 
@@ -259,7 +276,7 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
       g_param_spec_string("shm-name", "Shared-memory name",
                           "Name of the POSIX shared-memory segment (required): a '/' followed by up to 255 "
                           "characters without another '/', e.g. /neuflow-front (on Linux /dev/shm/neuflow-front). "
-                          "Created with mode 0640 when the element starts, unlinked when it stops",
+                          "Created with shm-mode when the element starts, unlinked when it stops",
                           nullptr, rw_ready));
   g_object_class_install_property(
       gobject_class, PROP_SLOTS,
@@ -267,6 +284,13 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
                         "Number of flows the ring holds: readers can still read a flow until this many newer ones "
                         "have been published",
                         1, MAX_SLOTS, DEFAULT_SLOTS, rw_ready));
+  g_object_class_install_property(
+      gobject_class, PROP_SHM_MODE,
+      g_param_spec_uint("shm-mode", "Shared-memory mode",
+                        "Permissions of the segment, set exactly whatever the umask (write it in octal: shm-mode=0644; "
+                        "gst-launch reads a leading 0 as octal). The default 0640 lets the owner's group read: run "
+                        "readers as that user or in that group. Read and write bits only, the owner's included",
+                        0600, 0666, DEFAULT_SHM_MODE, rw_ready));
   g_object_class_install_property(
       gobject_class, PROP_FLOWS_WRITTEN,
       g_param_spec_uint64("flows-written", "Flows written", "Flows published into the ring since the element started",
@@ -292,6 +316,7 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
 static void gst_neuflow_shm_sink_init(GstNeuflowShmSink *self) {
   self->shm_name = nullptr;
   self->slots = DEFAULT_SLOTS;
+  self->shm_mode = DEFAULT_SHM_MODE;
   self->flows_written = 0;
   self->buffers_skipped = 0;
   self->next_generation = 0;

@@ -3,8 +3,11 @@
 // ownership errors, a writer racing a separate reader process (neuflow-shm-reader --check),
 // and the Python reader.
 #include <fcntl.h>
+#include <grp.h>
 #include <gtest/gtest.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -19,6 +22,7 @@
 #include <vector>
 
 #include "neuflow/flow/flow_io.hpp"
+#include "flow_ring_writer.hpp"
 #include "neuflow/flow_ring.hpp"
 #include "sink_test_util.hpp"
 
@@ -497,6 +501,86 @@ TEST(NeuflowShmSinkPythonReader, ReadsTheNewestFlowExactly) {
   ASSERT_EQ(field.width, 10);
   ASSERT_EQ(field.height, 7);
   EXPECT_EQ(field.uv, vectors_of(nth_flow(2, 10, 7)));
+}
+
+// What a reader running as another user gets, checked as two users: the test (root) creates
+// the ring, then a child process drops to an unprivileged uid, in the segment's group or not,
+// and tries to open it the way neuflow::ring::FlowRingReader does. Under systemd the daemon's
+// units give the segment the fixed group `neuflow` (Group=neuflow), which readers join.
+class FlowRingAsAnotherUser : public ::testing::Test {
+ protected:
+  static constexpr uid_t kReaderUid = 65534;   // nobody
+  static constexpr gid_t kRingGroup = 64000;   // stands for the `neuflow` group
+  static constexpr gid_t kOtherGroup = 64001;
+
+  void SetUp() override {
+    if (::geteuid() != 0) GTEST_SKIP() << "needs root to act as a second user (CI runs as root)";
+  }
+
+  // 0: opened and mapped the header; otherwise the errno of shm_open.
+  static int open_as(uid_t uid, gid_t gid, const std::string &name) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+      const gid_t groups[] = {gid};
+      if (::setgroups(1, groups) != 0 || ::setgid(gid) != 0 || ::setuid(uid) != 0) ::_exit(200);
+      const int fd = ::shm_open(name.c_str(), O_RDONLY, 0);
+      if (fd < 0) ::_exit(errno);
+      // What FlowRingReader does next: map it for reading.
+      void *header = ::mmap(nullptr, sizeof(neuflow::ring::RingHeader), PROT_READ, MAP_SHARED, fd, 0);
+      ::_exit(header == MAP_FAILED ? 201 : 0);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 202;
+  }
+
+  static void give_group(const std::string &name, gid_t gid) {
+    ASSERT_EQ(::chown(("/dev/shm" + name).c_str(), static_cast<uid_t>(-1), gid), 0) << std::strerror(errno);
+  }
+};
+
+TEST_F(FlowRingAsAnotherUser, TheDefaultModeLetsTheGroupReadAndNobodyElse) {
+  const std::string name = unique_name("mode-default");
+  const mode_t old_umask = ::umask(077);  // the mode is set exactly, whatever the umask
+  gst::FlowRingWriter writer(name, 2, 0);
+  ::umask(old_umask);
+  struct stat st {};
+  ASSERT_EQ(::stat(("/dev/shm" + name).c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0640u);
+  give_group(name, kRingGroup);
+  EXPECT_EQ(open_as(kReaderUid, kRingGroup, name), 0) << "a reader in the ring's group cannot read it";
+  EXPECT_EQ(open_as(kReaderUid, kOtherGroup, name), EACCES) << "a reader outside the group can read it";
+}
+
+TEST_F(FlowRingAsAnotherUser, Mode0644LetsEveryoneRead) {
+  const std::string name = unique_name("mode-0644");
+  gst::FlowRingWriter writer(name, 2, 0, 0644);
+  give_group(name, kRingGroup);
+  EXPECT_EQ(open_as(kReaderUid, kOtherGroup, name), 0);
+}
+
+TEST(FlowRingMode, OnlyReadAndWriteBitsWithTheOwnersAreAccepted) {
+  EXPECT_FALSE(gst::check_flow_ring_mode(0640));
+  EXPECT_FALSE(gst::check_flow_ring_mode(0600));
+  EXPECT_FALSE(gst::check_flow_ring_mode(0666));
+  for (const mode_t bad : {0400, 0200, 0644 | 0100, 0610, 04640, 01640, 0777}) {
+    EXPECT_TRUE(gst::check_flow_ring_mode(static_cast<mode_t>(bad))) << std::oct << bad;
+  }
+  EXPECT_THROW(gst::FlowRingWriter(unique_name("mode-bad"), 2, 0, 0700), gst::FlowRingError);
+}
+
+TEST(NeuflowShmSink, ShmModeIsAppliedAndAnInvalidOneFailsAtStart) {
+  const std::string name = unique_name("mode-prop");
+  {
+    auto s = start_sink("neuflowshmsink", {{"shm-name", name}, {"shm-mode", "0644"}});
+    ASSERT_TRUE(s.harness);
+    struct stat st {};
+    ASSERT_EQ(::stat(("/dev/shm" + name).c_str(), &st), 0);
+    EXPECT_EQ(st.st_mode & 07777, 0644u);
+  }
+  const ErrorMessage error = start_error("neuflowshmsink", {{"shm-name", name}, {"shm-mode", "0610"}});
+  ASSERT_TRUE(error.found);
+  EXPECT_NE(error.message.find("Invalid shm-mode 0610"), std::string::npos) << error.message;
 }
 
 }  // namespace

@@ -264,6 +264,22 @@ TEST(Config, ConfigIssueAndConfigErrorText) {
 
 // ---- mistakes ------------------------------------------------------------------------------
 
+TEST(ConfigValues, ShmModeIsOctalAsAStringOrATomlOctalInteger) {
+  const auto mode_of = [](const std::string& value) {
+    const Config c = parse("[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
+                           "sink = [ { type = \"shm\", shm-name = \"/x\", shm-mode = " + value + " } ]\n");
+    return std::get<ShmSink>(c.streams[0].sinks[0].settings).mode;
+  };
+  EXPECT_EQ(mode_of("\"0644\""), 0644u);
+  EXPECT_EQ(mode_of("\"660\""), 0660u);
+  EXPECT_EQ(mode_of("0o600"), 0600u);
+  for (const std::string bad : {"\"0700\"", "\"0400\"", "\"rw-r-----\"", "644", "\"04640\""}) {
+    const auto issues = issues_of("[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
+                                  "sink = [ { type = \"shm\", shm-name = \"/x\", shm-mode = " + bad + " } ]\n");
+    EXPECT_TRUE(has_issue(issues, 5, 0, "shm-mode: expected an octal mode like \"0640\"")) << bad;
+  }
+}
+
 TEST(ConfigErrors, TomlSyntaxErrorGivesItsPosition) {
   const auto issues = issues_of("[daemon]\nthreads = 4\nlog-level = \"info\n");
   ASSERT_EQ(issues.size(), 1u);

@@ -355,6 +355,33 @@ class DaemonVideoOut(DaemonTestCase):
         self.assertEqual(d.stop(), 0)
 
 
+    def test_rtsp_credentials_keep_out_who_is_not_listed(self):
+        rtsp_port = free_port()
+        users = os.path.join(self.dir, "rtsp-users")
+        with open(users, "w") as f:
+            f.write("# who may watch\nviewer:s3cret\n")
+        os.chmod(users, 0o600)
+        d = self.start(f'[rtsp]\nlisten = "127.0.0.1:{rtsp_port}"\ncredentials = "{users}"\n' +
+                       stream_block("cam", test_source(), ['  type = "video"\n  rtsp = "/cam"']))
+        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_log(r"rtsp: 1 user from .*rtsp-users \(digest authentication\)", timeout=10)
+
+        def watch(*login):
+            return subprocess.run([os.environ["GST_LAUNCH"], "-q", "rtspsrc", f"location=rtsp://127.0.0.1:{rtsp_port}/cam",
+                                   *login, "!", "rtph264depay", "!", "avdec_h264", "!", "fakesink", "num-buffers=3"],
+                                  capture_output=True, text=True, timeout=60, env=plain_gst_env())
+
+        anonymous = watch()
+        self.assertNotEqual(anonymous.returncode, 0, "an anonymous client could watch")
+        self.assertIn("Unauthorized", anonymous.stderr + anonymous.stdout)
+        wrong = watch("user-id=viewer", "user-pw=guess")
+        self.assertNotEqual(wrong.returncode, 0, "a wrong password could watch")
+        right = watch("user-id=viewer", "user-pw=s3cret")
+        self.assertEqual(right.returncode, 0, right.stderr[-2000:])
+        self.assertNotIn("WITHOUT authentication", d.log_text())
+        self.assertEqual(d.stop(), 0)
+
+
 class DaemonFailures(DaemonTestCase):
     def test_failing_source_restarts_while_other_stream_runs(self):
         # Nothing listens on this port: the RTSP source fails at once, every time.

@@ -29,6 +29,7 @@ foreach(test_case
     DaemonLifecycle.test_ready_flows_reload_and_clean_stop
     DaemonLifecycle.test_watchdog_and_status
     DaemonVideoOut.test_rtsp_mount_and_rtp_udp_deliver_decodable_h264
+    DaemonVideoOut.test_rtsp_credentials_keep_out_who_is_not_listed
     DaemonFailures.test_failing_source_restarts_while_other_stream_runs
     DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
     CheckConfig.test_valid_config_passes

@@ -110,7 +110,18 @@ case $mode in
       grep -q "^ExecStart=$prefix/bin/neuflowd " "$units/$unit" ||
         fail "$unit: ExecStart= does not start the installed $prefix/bin/neuflowd"
       verify "$units/$unit"
+      grep -q '^Group=neuflow$' "$units/$unit" || fail "$unit: not run in the group neuflow"
     done
+    sysusers="$prefix/lib/sysusers.d/neuflow.conf"
+    [ -f "$sysusers" ] || fail "the sysusers.d file that creates the group neuflow is not installed ($sysusers)"
+    if command -v systemd-sysusers > /dev/null; then
+      # --dry-run with --root: parsed and planned against an empty tree, nothing created here.
+      mkdir -p "$work/root/etc"
+      out=$(systemd-sysusers --root="$work/root" --dry-run "$sysusers" 2>&1) ||
+        { echo "$out"; fail "systemd-sysusers rejects $sysusers"; }
+      grep -q "neuflow" <<<"$out" || { echo "$out"; fail "systemd-sysusers would not create the group neuflow"; }
+      echo "ok: systemd-sysusers would create: $out"
+    fi
     ;;
 
   *)

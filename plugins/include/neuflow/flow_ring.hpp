@@ -344,7 +344,8 @@ class FlowRingReader {
       if (err == ENOENT) fail(RingError::Kind::no_such_segment, "no such shared-memory segment (is the writer running?)");
       if (err == EACCES) {
         fail(RingError::Kind::permission_denied,
-             "permission denied (the writer creates it with mode 0640: readers must run as its user or group)");
+             "permission denied (the writer's shm-mode is 0640 by default: run the reader as the writer's user or "
+             "in its group, which is 'neuflow' under neuflowd's systemd units, or give the writer shm-mode=0644)");
       }
       fail(RingError::Kind::system, "cannot open: " + errno_text(err));
     }
