@@ -5,7 +5,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <malloc.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <string>
 
@@ -16,6 +19,17 @@
 namespace {
 
 constexpr int kExitConfig = 78;  // EX_CONFIG: the unit's RestartPreventExitStatus
+
+// glibc raises its mmap threshold (up to 32 MiB) each time a large block is freed, after which
+// large buffers come from the heap arenas; a reload frees and rebuilds a stream's sessions and
+// pipeline from other threads, and the arenas keep the freed space. Measured: 100 alternating
+// reloads took a daemon from 236 to 416 MB of RSS, for good. With a fixed threshold large
+// buffers are mapped and unmapped whole, and RSS after those reloads stays within 2% of a fresh
+// start (daemon/README.md, "Memory"). MALLOC_MMAP_THRESHOLD_ in the environment still wins.
+void keep_large_allocations_mapped() {
+  if (std::getenv("MALLOC_MMAP_THRESHOLD_") != nullptr) return;
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+}
 
 void print_issues(const neuflow::daemon::ConfigError& e) {
   for (const auto& issue : e.issues()) std::fprintf(stderr, "%s\n", issue.to_string().c_str());
@@ -38,6 +52,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   using namespace neuflow::daemon;
+  keep_large_allocations_mapped();
   use_log_prefix_from_environment();
   gst_init(nullptr, nullptr);
 

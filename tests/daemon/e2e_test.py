@@ -191,11 +191,11 @@ name = "{name}"
     return text
 
 
-def test_source(frames=None, fps=10):
+def test_source(frames=None, fps=10, width=64, height=48):
     text = f"""  type = "test"
   pattern = "ball"
-  width = 64
-  height = 48
+  width = {width}
+  height = {height}
   framerate = {fps}"""
     return text + (f"\n  frames = {frames}" if frames else "")
 
@@ -604,6 +604,42 @@ class DaemonReliability(DaemonTestCase):
             self.assertGreaterEqual(metric(after, name, "s"), metric(before, name, "s"), name)
         self.assertEqual(d.stop(), 0)
         self.assertLessEqual(len(flow_files(files)), 10)
+
+
+    def test_memory_after_alternating_reloads_stays_near_a_fresh_start(self):
+        if os.environ.get("NEUFLOW_E2E_SANITIZED"):
+            self.skipTest("RSS under the sanitizers' allocator says nothing about glibc's")
+        metrics_port = free_port()
+
+        def config(variant):
+            width, height, iters = (320, 240, 4) if variant == "a" else (256, 192, 6)
+            return (f'[metrics]\nlisten = "127.0.0.1:{metrics_port}"\n' +
+                    stream_block("changes", test_source(fps=15, width=320, height=240), [
+                        '  type = "files"\n  directory = "%s"\n  max-files = 10' % os.path.join(self.dir, "a")])
+                    .replace("iters-s8 = 1", f"iters-s8 = {iters}\n  model-width = {width}\n  model-height = {height}") +
+                    stream_block("steady", test_source(fps=15, width=320, height=240), [
+                        '  type = "files"\n  directory = "%s"\n  max-files = 10' % os.path.join(self.dir, "b")]))
+
+        def rss_mb(pid):
+            with open(f"/proc/{pid}/status") as f:
+                return int(next(l for l in f if l.startswith("VmRSS:")).split()[1]) / 1024
+
+        d = self.start(config("a"))
+        d.notify.wait_for("READY=1", timeout=60)
+        wait_until(lambda: len(flow_files(os.path.join(self.dir, "a"))) >= 5, 60, "no flows")
+        time.sleep(2)
+        fresh = rss_mb(d.proc.pid)
+        for i in range(24):
+            d.rewrite(config("b" if i % 2 == 0 else "a"))
+            d.proc.send_signal(signal.SIGHUP)
+            time.sleep(1.5)
+        d.notify.wait_for("READY=1", timeout=60)
+        time.sleep(4)
+        after = rss_mb(d.proc.pid)
+        self.assertGreaterEqual(d.log_text().count("stream changes: settings changed"), 20)
+        # Measured before the fix: 236 -> 406 MB after 30 such reloads (1.7x), for good.
+        self.assertLess(after, 1.3 * fresh, f"RSS {fresh:.0f} MB fresh, {after:.0f} MB after 24 reloads")
+        self.assertEqual(d.stop(), 0)
 
 
 if __name__ == "__main__":

@@ -22,7 +22,7 @@ set(e2e_env
 if(NEUFLOW_SANITIZE)
   # The registry scan would load the instrumented plugin into GStreamer's uninstrumented
   # gst-plugin-scanner; neuflowd (instrumented) scans in its own process instead.
-  list(APPEND e2e_env "GST_REGISTRY_FORK=no")
+  list(APPEND e2e_env "GST_REGISTRY_FORK=no" "NEUFLOW_E2E_SANITIZED=1")
 endif()
 
 foreach(test_case
@@ -38,7 +38,8 @@ foreach(test_case
     DaemonReliability.test_missing_camera_and_input_file_leave_the_other_streams_running
     DaemonReliability.test_a_sink_that_cannot_be_built_is_cut_off_at_start
     DaemonReliability.test_a_flood_of_idle_metrics_connections_starves_nothing
-    DaemonReliability.test_reload_keeps_counters_and_retention_counts_earlier_files)
+    DaemonReliability.test_reload_keeps_counters_and_retention_counts_earlier_files
+    DaemonReliability.test_memory_after_alternating_reloads_stays_near_a_fresh_start)
   add_test(NAME daemon.e2e.${test_case}
            COMMAND ${NEUFLOW_E2E_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/e2e_test.py -v ${test_case})
   set_tests_properties(daemon.e2e.${test_case} PROPERTIES LABELS "daemon;e2e" ENVIRONMENT "${e2e_env}"
