@@ -319,8 +319,7 @@ void Stream::read_counters() {
   current_.in = uint64_property(flow, "frames-in");
   current_.processed = uint64_property(flow, "frames-processed");
   current_.dropped = uint64_property(flow, "frames-dropped");
-  // Each run's first frame leaves without a flow: there is no previous frame to pair it with.
-  current_.flows = current_.processed > 0 ? current_.processed - 1 : 0;
+  current_.flows = uint64_property(flow, "flows");
   g_object_get(flow, "mean-latency", &latency_ms_, nullptr);
 }
 

@@ -6,8 +6,10 @@
  * processed frame to this one. Video passes through unchanged in any size and common raw
  * format; the element converts and pads or resizes internally.
  *
- * Inference runs on the element's own thread. In live mode (the default for live sources)
- * the streaming thread never waits for it: a frame arriving while the previous one is still
+ * Inference runs on the element's own thread, and a second thread pushes its results
+ * downstream, so the next frame is computed while the last one waits in a sink's clock sync
+ * (no queue is needed after the element). In live mode (the default for live sources) the
+ * streaming thread never waits for inference: a frame arriving while the previous one is still
  * queued replaces it (newest wins), the replaced frame is dropped and announced with a QoS
  * message, and the latency is reported in the LATENCY query. In every-pair mode (the
  * default for non-live sources) every frame is processed, upstream waits when two frames are
@@ -25,8 +27,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "elements.hpp"
+#include "frame_handoff.hpp"
 #include "neuflow/gst/flow_meta.h"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
@@ -63,6 +64,7 @@ enum {
   PROP_STATS_INTERVAL,
   PROP_FRAMES_IN,
   PROP_FRAMES_PROCESSED,
+  PROP_FLOWS,
   PROP_FRAMES_DROPPED,
   PROP_MEAN_LATENCY,
   PROP_PROCESSING_RATE,
@@ -74,6 +76,8 @@ constexpr guint DEFAULT_MODEL_SIZE = 0;
 constexpr guint DEFAULT_THREADS = 0;
 constexpr guint DEFAULT_STATS_INTERVAL = 1000;  // ms; 0 = no stats messages
 constexpr std::size_t kEveryPairQueuedBuffers = 2;
+// Results waiting for the push thread: one is enough to overlap a push with the next inference.
+constexpr std::size_t kResultsWaiting = 1;
 
 struct Settings {
   std::string model;
@@ -113,20 +117,30 @@ struct Stats {
   std::chrono::steady_clock::time_point last_message{};
 };
 
-// Everything the worker and the streaming thread share lives under `lock`.
+using Handoff = neuflow::gst::FrameHandoff<Item>;
+
+void release_all(std::vector<Item> items) {
+  for (auto &item : items) release(item);
+}
+
+// Three threads: the streaming thread queues frames and events in `input`; the inference
+// worker (the element's own task) takes them in order, computes, and queues the results in
+// `output`; the src pad's task pushes those downstream. A downstream failure (flushing, EOS,
+// not linked) is recorded in both hand-offs and returned upstream from the next chain call.
 struct State {
-  std::mutex lock;
-  std::condition_variable cond;
-  std::deque<Item> queue;
-  bool flushing = true;
-  bool busy = false;                 // the worker holds an item
-  GstFlowReturn downstream = GST_FLOW_OK;  // the worker's last push result, returned upstream
+  Handoff input{kEveryPairQueuedBuffers};
+  Handoff output{kResultsWaiting};
+  GstTask *inference = nullptr;  // owned; runs inference_loop
+  GRecMutex inference_lock;      // held by the task while it runs an iteration
+
+  std::mutex lock;                   // guards what follows, up to the worker-only state
   std::optional<bool> live;          // resolved from the behaviour and upstream's liveness
   GstSegment segment{};
   Stats stats;
   guint64 next_frame = 0;
 
-  // Worker-only state (no lock needed: only the worker thread touches it while running).
+  // Worker-only state (no lock needed: only the inference worker touches it while it runs;
+  // the streaming thread only while the worker is paused, after a flush or stop).
   std::unique_ptr<FlowSession> session;
   GstVideoInfo info{};
   bool have_info = false;
@@ -194,9 +208,11 @@ Settings copy_settings(GstNeuflow *self) {
   return s;
 }
 
-void clear_queue(State &st) {
-  for (auto &item : st.queue) release(item);
-  st.queue.clear();
+// Stops the inference worker and waits for the item it is computing, if any.
+void pause_inference(State &st) {
+  gst_task_pause(st.inference);
+  g_rec_mutex_lock(&st.inference_lock);
+  g_rec_mutex_unlock(&st.inference_lock);
 }
 
 // ---- worker side ---------------------------------------------------------------------------
@@ -205,7 +221,7 @@ void post_stats(GstNeuflow *self, const Stats &s) {
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.started).count();
   GstStructure *st = gst_structure_new(
       "neuflow-stats", "frames-in", G_TYPE_UINT64, s.frames_in, "frames-processed", G_TYPE_UINT64, s.processed,
-      "frames-dropped", G_TYPE_UINT64, s.dropped, "mean-latency", G_TYPE_DOUBLE,
+      "flows", G_TYPE_UINT64, s.flows, "frames-dropped", G_TYPE_UINT64, s.dropped, "mean-latency", G_TYPE_DOUBLE,
       s.flows ? 1e3 * s.inference_seconds / static_cast<double>(s.flows) : 0.0, "processing-rate", G_TYPE_DOUBLE,
       elapsed > 0 ? static_cast<double>(s.processed) / elapsed : 0.0, nullptr);
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), st));
@@ -269,8 +285,10 @@ bool set_format(GstNeuflow *self, State &st, GstCaps *caps) {
   return true;
 }
 
+// Computes the flow into the frame; on success `*result` is the buffer to push (with its flow
+// meta, except for the first frame of a stream).
 GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guint64 frame_number,
-                            const Settings &settings) {
+                            const Settings &settings, GstBuffer **result) {
   if (!st.have_info) {
     gst_buffer_unref(buffer);
     GST_ELEMENT_ERROR(self, CORE, NEGOTIATION, (nullptr), ("a frame arrived before its caps"));
@@ -345,36 +363,35 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
   }
   if (post) post_stats(self, snapshot);
   if (announce) gst_element_post_message(GST_ELEMENT(self), gst_message_new_latency(GST_OBJECT(self)));
-  return gst_pad_push(self->srcpad, buffer);
+  *result = buffer;
+  return GST_FLOW_OK;
 }
 
-void worker_loop(gpointer data) {
+// The inference worker: one item of `input` per iteration, its result into `output`.
+void inference_loop(gpointer data) {
   auto *self = GST_NEUFLOW(data);
   State &st = *self->state;
-  Item item;
-  {
-    std::unique_lock lock(st.lock);
-    st.cond.wait(lock, [&] { return st.flushing || !st.queue.empty(); });
-    if (st.flushing) {
-      lock.unlock();
-      gst_pad_pause_task(self->srcpad);
-      return;
-    }
-    item = st.queue.front();
-    st.queue.pop_front();
-    st.busy = true;
+  auto entry = st.input.take();
+  if (!entry) {  // flushing: a flush or a stop pauses or stops this task
+    gst_task_pause(st.inference);
+    return;
   }
-  st.cond.notify_all();
-
+  Item item = entry->value;
   GstFlowReturn ret = GST_FLOW_OK;
-  const Settings settings = copy_settings(self);
   if (item.buffer) {
-    ret = process_frame(self, st, item.buffer, item.frame, settings);
+    GstBuffer *result = nullptr;
+    ret = process_frame(self, st, item.buffer, item.frame, copy_settings(self), &result);
+    if (ret == GST_FLOW_OK) {
+      Item out{result, nullptr, item.frame};
+      // Waits while the push thread is still busy with a result: a slow downstream slows us.
+      if (st.output.push_frame(out, Handoff::Policy::back_pressure) != Handoff::Result::queued) {
+        gst_buffer_unref(result);  // flushing, or downstream failed: nobody takes it
+      }
+    }
   } else {
-    GstEvent *event = item.event;
-    if (GST_EVENT_TYPE(event) == GST_EVENT_CAPS) {
+    if (GST_EVENT_TYPE(item.event) == GST_EVENT_CAPS) {
       GstCaps *caps = nullptr;
-      gst_event_parse_caps(event, &caps);
+      gst_event_parse_caps(item.event, &caps);
       if (!set_format(self, st, caps)) {
         gchar *text = gst_caps_to_string(caps);
         GST_ELEMENT_ERROR(self, CORE, NEGOTIATION, (nullptr), ("unusable caps %s", text));
@@ -382,24 +399,41 @@ void worker_loop(gpointer data) {
         ret = GST_FLOW_NOT_NEGOTIATED;
       }
     }
-    const bool is_eos = GST_EVENT_TYPE(event) == GST_EVENT_EOS;
-    if (!gst_pad_push_event(self->srcpad, event) && is_eos) {
-      GST_DEBUG_OBJECT(self, "downstream refused EOS");
-    }
+    if (st.output.push_other(item) != Handoff::Result::queued) gst_event_unref(item.event);
   }
+  st.input.done();
+  if (ret != GST_FLOW_OK) {
+    // Our own failure (already posted as an element error): upstream learns it at its next
+    // frame, downstream gets an end of stream after what was computed before.
+    GST_DEBUG_OBJECT(self, "pausing inference: %s", gst_flow_get_name(ret));
+    st.input.fail(ret);
+    Item eos{nullptr, gst_event_new_eos(), 0};
+    if (st.output.push_other(eos) != Handoff::Result::queued) gst_event_unref(eos.event);
+    gst_task_pause(st.inference);
+  }
+}
 
-  bool pause = false;
-  {
-    const std::lock_guard lock(st.lock);
-    st.busy = false;
-    if (ret != GST_FLOW_OK) {
-      st.downstream = ret;
-      pause = true;
-    }
+// The src pad's task: pushes the worker's results downstream, in order.
+void push_loop(gpointer data) {
+  auto *self = GST_NEUFLOW(data);
+  State &st = *self->state;
+  auto entry = st.output.take();
+  if (!entry) {
+    gst_pad_pause_task(self->srcpad);
+    return;
   }
-  st.cond.notify_all();
-  if (pause) {
-    GST_DEBUG_OBJECT(self, "pausing worker: %s", gst_flow_get_name(ret));
+  Item item = entry->value;
+  GstFlowReturn ret = GST_FLOW_OK;
+  if (item.buffer) {
+    ret = gst_pad_push(self->srcpad, item.buffer);
+  } else if (!gst_pad_push_event(self->srcpad, item.event) && GST_EVENT_TYPE(item.event) == GST_EVENT_EOS) {
+    GST_DEBUG_OBJECT(self, "downstream refused EOS");
+  }
+  st.output.done();
+  if (ret != GST_FLOW_OK) {
+    GST_DEBUG_OBJECT(self, "pausing push: %s", gst_flow_get_name(ret));
+    st.input.fail(ret);
+    st.output.fail(ret);
     if (ret == GST_FLOW_NOT_LINKED || ret < GST_FLOW_EOS) {
       GST_ELEMENT_FLOW_ERROR(self, ret);
       gst_pad_push_event(self->srcpad, gst_event_new_eos());
@@ -444,54 +478,36 @@ GstFlowReturn sink_chain(GstPad * /*pad*/, GstObject *parent, GstBuffer *buffer)
     st.live = live = resolved;
   }
 
-  std::unique_lock lock(st.lock);
-  ++st.stats.frames_in;
-  const guint64 frame = st.next_frame++;
-  if (st.flushing) {
-    gst_buffer_unref(buffer);
-    return GST_FLOW_FLUSHING;
+  guint64 frame = 0;
+  {
+    const std::lock_guard lock(st.lock);
+    ++st.stats.frames_in;
+    frame = st.next_frame++;
   }
-  if (st.downstream != GST_FLOW_OK) {
-    gst_buffer_unref(buffer);
-    return st.downstream;
-  }
-  std::vector<GstBuffer *> dropped;
-  guint64 processed = 0, drops = 0;
-  GstSegment segment{};
-  if (*live) {
-    // Newest wins: a frame still waiting for the worker is replaced by this one. The QoS
-    // messages are posted after unlocking, from what was collected here.
-    for (auto it = st.queue.begin(); it != st.queue.end();) {
-      if (it->buffer) {
-        dropped.push_back(it->buffer);
-        it = st.queue.erase(it);
-      } else {
-        ++it;
-      }
+  // Newest wins when live: a frame still waiting for the worker is replaced by this one, and
+  // its QoS message is posted here, after the hand-off. Every pair: wait for room.
+  Item item{buffer, nullptr, frame};
+  std::vector<Item> dropped;
+  const auto queued = st.input.push_frame(
+      item, *live ? Handoff::Policy::newest_wins : Handoff::Policy::back_pressure, &dropped);
+  if (!dropped.empty()) {
+    guint64 processed = 0, drops = 0;
+    GstSegment segment{};
+    {
+      const std::lock_guard lock(st.lock);
+      st.stats.dropped += dropped.size();
+      processed = st.stats.processed;
+      drops = st.stats.dropped;
+      segment = st.segment;
     }
-    st.stats.dropped += dropped.size();
-    processed = st.stats.processed;
-    drops = st.stats.dropped;
-    segment = st.segment;
-  } else {
-    st.cond.wait(lock, [&] {
-      std::size_t buffers = 0;
-      for (const auto &item : st.queue) buffers += item.buffer != nullptr;
-      return st.flushing || st.downstream != GST_FLOW_OK || buffers < kEveryPairQueuedBuffers;
-    });
-    if (st.flushing || st.downstream != GST_FLOW_OK) {
-      gst_buffer_unref(buffer);
-      return st.flushing ? GST_FLOW_FLUSHING : st.downstream;
+    for (Item &old : dropped) {
+      post_drop(self, old.buffer, segment, processed, drops);
+      release(old);
     }
   }
-  st.queue.push_back(Item{buffer, nullptr, frame});
-  lock.unlock();
-  st.cond.notify_all();
-  for (GstBuffer *old : dropped) {
-    post_drop(self, old, segment, processed, drops);
-    gst_buffer_unref(old);
-  }
-  return GST_FLOW_OK;
+  if (queued == Handoff::Result::queued) return GST_FLOW_OK;
+  gst_buffer_unref(buffer);
+  return queued == Handoff::Result::flushing ? GST_FLOW_FLUSHING : static_cast<GstFlowReturn>(st.input.failure());
 }
 
 gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
@@ -499,27 +515,24 @@ gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
   State &st = *self->state;
   switch (GST_EVENT_TYPE(event)) {
     case GST_EVENT_FLUSH_START: {
-      {
-        const std::lock_guard lock(st.lock);
-        st.flushing = true;
-        clear_queue(st);
-      }
-      st.cond.notify_all();
+      release_all(st.input.start_flushing());
+      release_all(st.output.start_flushing());
       const gboolean ok = gst_pad_push_event(self->srcpad, event);
-      gst_pad_pause_task(self->srcpad);  // returns once the worker finished its current item
+      gst_pad_pause_task(self->srcpad);  // returns once the push thread finished its current item
+      pause_inference(st);               // returns once the worker finished its current item
       return ok;
     }
     case GST_EVENT_FLUSH_STOP: {
-      {
-        const std::lock_guard lock(st.lock);
-        clear_queue(st);
-        st.flushing = false;
-        st.downstream = GST_FLOW_OK;
-        if (st.session) st.session->reset();
-        st.previous_pts = GST_CLOCK_TIME_NONE;
-      }
+      // Both threads are paused: the worker-only state is ours.
+      release_all(st.input.start_flushing());
+      release_all(st.output.start_flushing());
+      st.input.stop_flushing();
+      st.output.stop_flushing();
+      if (st.session) st.session->reset();
+      st.previous_pts = GST_CLOCK_TIME_NONE;
       const gboolean ok = gst_pad_push_event(self->srcpad, event);
-      gst_pad_start_task(self->srcpad, worker_loop, self, nullptr);
+      gst_pad_start_task(self->srcpad, push_loop, self, nullptr);
+      gst_task_start(st.inference);
       return ok;
     }
     case GST_EVENT_CAPS: {
@@ -548,15 +561,11 @@ gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
       break;
   }
   if (!GST_EVENT_IS_SERIALIZED(event)) return gst_pad_event_default(pad, parent, event);
-  {
-    const std::lock_guard lock(st.lock);
-    if (st.flushing) {
-      gst_event_unref(event);
-      return FALSE;
-    }
-    st.queue.push_back(Item{nullptr, event, 0});
+  Item item{nullptr, event, 0};
+  if (st.input.push_other(item) != Handoff::Result::queued) {
+    gst_event_unref(event);
+    return FALSE;
   }
-  st.cond.notify_all();
   return TRUE;
 }
 
@@ -564,10 +573,9 @@ gboolean sink_query(GstPad *pad, GstObject *parent, GstQuery *query) {
   auto *self = GST_NEUFLOW(parent);
   State &st = *self->state;
   if (GST_QUERY_IS_SERIALIZED(query)) {
-    // Serialized queries (allocation, drain) must not overtake the frames queued before them.
-    std::unique_lock lock(st.lock);
-    st.cond.wait(lock, [&] { return st.flushing || (st.queue.empty() && !st.busy); });
-    if (st.flushing) return FALSE;
+    // Serialized queries (allocation, drain) must not overtake the frames queued before them:
+    // the worker has computed them all, then the push thread has pushed them all.
+    if (!st.input.wait_drained() || !st.output.wait_drained()) return FALSE;
   }
   return gst_pad_query_default(pad, parent, query);
 }
@@ -598,20 +606,21 @@ gboolean src_activate_mode(GstPad *pad, GstObject *parent, GstPadMode mode, gboo
   State &st = *self->state;
   if (mode != GST_PAD_MODE_PUSH) return FALSE;
   if (active) {
-    {
-      const std::lock_guard lock(st.lock);
-      st.flushing = false;
-      st.downstream = GST_FLOW_OK;
-    }
-    return gst_pad_start_task(pad, worker_loop, self, nullptr);
+    st.input.stop_flushing();
+    st.output.stop_flushing();
+    if (!gst_task_start(st.inference)) return FALSE;
+    return gst_pad_start_task(pad, push_loop, self, nullptr);
   }
-  {
-    const std::lock_guard lock(st.lock);
-    st.flushing = true;
-    clear_queue(st);
-  }
-  st.cond.notify_all();
-  return gst_pad_stop_task(pad);
+  release_all(st.input.start_flushing());
+  release_all(st.output.start_flushing());
+  const gboolean stopped = gst_pad_stop_task(pad);
+  // Stopped while no iteration runs (the task holds this lock during one), so that the worker
+  // cannot pause the task again after the stop and leave the join waiting.
+  g_rec_mutex_lock(&st.inference_lock);
+  gst_task_stop(st.inference);
+  g_rec_mutex_unlock(&st.inference_lock);
+  gst_task_join(st.inference);
+  return stopped;
 }
 
 // ---- lifecycle -----------------------------------------------------------------------------
@@ -711,6 +720,7 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
     switch (id) {
       case PROP_FRAMES_IN: g_value_set_uint64(value, s.frames_in); break;
       case PROP_FRAMES_PROCESSED: g_value_set_uint64(value, s.processed); break;
+      case PROP_FLOWS: g_value_set_uint64(value, s.flows); break;
       case PROP_FRAMES_DROPPED: g_value_set_uint64(value, s.dropped); break;
       case PROP_MEAN_LATENCY:
         g_value_set_double(value, s.flows ? 1e3 * s.inference_seconds / static_cast<double>(s.flows) : 0.0);
@@ -741,7 +751,10 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
 
 void finalize(GObject *object) {
   auto *self = GST_NEUFLOW(object);
-  clear_queue(*self->state);
+  release_all(self->state->input.start_flushing());
+  release_all(self->state->output.start_flushing());
+  gst_object_unref(self->state->inference);
+  g_rec_mutex_clear(&self->state->inference_lock);
   if (self->state->converter) gst_video_converter_free(self->state->converter);
   delete self->state;
   delete self->model;
@@ -812,8 +825,15 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
       g_param_spec_uint64("frames-in", "Frames in", "Frames received", 0, G_MAXUINT64, 0, ro));
   g_object_class_install_property(
       gobject_class, PROP_FRAMES_PROCESSED,
-      g_param_spec_uint64("frames-processed", "Frames processed", "Frames that left the element", 0, G_MAXUINT64, 0,
-                          ro));
+      g_param_spec_uint64("frames-processed", "Frames processed",
+                          "Frames computed, the first of a stream (which has no flow yet) included", 0, G_MAXUINT64,
+                          0, ro));
+  g_object_class_install_property(
+      gobject_class, PROP_FLOWS,
+      g_param_spec_uint64("flows", "Flows",
+                          "Frames that left with a flow (frames-processed less the first frame of each stream, "
+                          "of each flush and of each size change)",
+                          0, G_MAXUINT64, 0, ro));
   g_object_class_install_property(
       gobject_class, PROP_FRAMES_DROPPED,
       g_param_spec_uint64("frames-dropped", "Frames dropped", "Frames dropped to hold real-time (live behaviour)", 0,
@@ -842,6 +862,12 @@ static void gst_neuflow_init(GstNeuflow *self) {
   self->model = new std::shared_ptr<const FlowModel>();
   self->state = new State();
   gst_segment_init(&self->state->segment, GST_FORMAT_TIME);
+  // Flushing until the src pad is activated.
+  release_all(self->state->input.start_flushing());
+  release_all(self->state->output.start_flushing());
+  g_rec_mutex_init(&self->state->inference_lock);
+  self->state->inference = gst_task_new(inference_loop, self, nullptr);
+  gst_task_set_lock(self->state->inference, &self->state->inference_lock);
 
   self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
   gst_pad_set_chain_function(self->sinkpad, sink_chain);
