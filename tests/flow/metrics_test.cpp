@@ -122,5 +122,29 @@ TEST(Metrics, SizeMismatchIsAClearError) {
   EXPECT_THROW(compute_metrics(broken, FlowField(2, 2)), std::invalid_argument);
 }
 
+// Pooled counts give the measures of the pixels together: the same as one field holding both.
+TEST(Metrics, PooledCountsEqualTheMetricsOfTheFieldsTogether) {
+  const FlowField gt_a = constant(4, 2, 1.f, 0.f), pred_a = constant(4, 2, 4.f, 4.f);  // error 5
+  const FlowField gt_b = constant(2, 2, 0.f, 0.f), pred_b = constant(2, 2, 0.5f, 0.f);  // error 0.5
+  MetricCounts pooled = compute_metrics(pred_a, gt_a).counts;
+  pooled += compute_metrics(pred_b, gt_b).counts;
+  FlowField gt_ab(12, 1), pred_ab(12, 1);
+  for (int i = 0; i < 12; ++i) {
+    const bool a = i < 8;
+    gt_ab.uv[2 * i] = a ? 1.f : 0.f;
+    pred_ab.uv[2 * i] = a ? 4.f : 0.5f;
+    pred_ab.uv[2 * i + 1] = a ? 4.f : 0.f;
+  }
+  const FlowMetrics together = compute_metrics(pred_ab, gt_ab);
+  const FlowMetrics from_counts = metrics_from_counts(pooled);
+  EXPECT_EQ(from_counts.valid_pixels, 12u);
+  EXPECT_DOUBLE_EQ(from_counts.epe, together.epe);
+  EXPECT_DOUBLE_EQ(from_counts.epe, (8 * 5.0 + 4 * 0.5) / 12);
+  EXPECT_DOUBLE_EQ(from_counts.fl_all, together.fl_all);
+  EXPECT_DOUBLE_EQ(from_counts.within_1px, together.within_1px);
+  EXPECT_DOUBLE_EQ(from_counts.within_5px, together.within_5px);
+  EXPECT_TRUE(std::isnan(metrics_from_counts(MetricCounts{}).epe));
+}
+
 }  // namespace
 }  // namespace neuflow::flow

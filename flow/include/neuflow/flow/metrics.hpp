@@ -6,6 +6,19 @@
 
 namespace neuflow::flow {
 
+// What the measures are made of, over the evaluated pixels: sums and counts, so that several
+// fields can be pooled exactly (benchmark sets add up their pairs' counts).
+struct MetricCounts {
+  std::size_t pixels = 0;      // evaluated
+  double error_sum = 0;        // Σ end-point error, px
+  std::size_t outliers = 0;    // KITTI Fl: error > 3 px and > 5% of |gt|
+  std::size_t within_1px = 0;  // error < 1 px
+  std::size_t within_3px = 0;
+  std::size_t within_5px = 0;
+
+  MetricCounts& operator+=(const MetricCounts& other);
+};
+
 struct FlowMetrics {
   double epe = 0;     // mean end-point error |pred − gt| in px
   double fl_all = 0;  // KITTI Fl-all: share with error > 3 px and > 5% of |gt|, in [0, 1]
@@ -14,7 +27,12 @@ struct FlowMetrics {
   double within_5px = 0;
   std::size_t valid_pixels = 0;  // pixels that were evaluated
   std::size_t total_pixels = 0;  // width × height
+  MetricCounts counts;           // what the ratios above are made of
 };
+
+// The measures of pooled counts: every ratio over `counts.pixels`, NaN when it is 0.
+// `total_pixels` is only carried over.
+FlowMetrics metrics_from_counts(const MetricCounts& counts, std::size_t total_pixels = 0);
 
 struct MetricsOptions {
   // Ground truth decides which pixels count. By default the prediction's own mask is

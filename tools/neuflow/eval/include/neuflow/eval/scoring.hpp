@@ -26,10 +26,7 @@ class ScoreAccumulator {
  private:
   Aggregation aggregation_;
   std::size_t pairs_ = 0;
-  std::size_t pixels_ = 0;
-  double error_sum_ = 0;  // Σ EPE × valid pixels: the pooled error
-  // Counts recovered from the pair's ratios (exact: each ratio is count / pixels in double).
-  std::size_t outliers_ = 0, within1_ = 0, within3_ = 0, within5_ = 0;
+  flow::MetricCounts pooled_;      // every pair's pixels together
   double image_epe_sum_ = 0;       // Σ per-image EPE, for mean_of_images
   std::size_t images_scored_ = 0;  // images with at least one valid pixel
 };
