@@ -9,7 +9,7 @@ target_compile_options(neuflow_options INTERFACE
   $<$<NOT:$<BOOL:$<TARGET_PROPERTY:NEUFLOW_GLIB_MACROS>>>:-Wold-style-cast>
   -Woverloaded-virtual -Wformat=2 -Wimplicit-fallthrough
   # GCC 12 reports -Wrestrict inside libstdc++'s own std::string code at -O3 (GCC bug 105329).
-  -Wno-restrict
+  $<$<CXX_COMPILER_ID:GNU>:-Wno-restrict>
   # GCC 12 warns on designated initializers that leave members at their defaults (bug 96868).
   -Wno-missing-field-initializers
   $<$<BOOL:${NEUFLOW_WERROR}>:-Werror>)
@@ -28,5 +28,15 @@ if(NEUFLOW_SANITIZE)
   target_compile_options(neuflow_options INTERFACE
     -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
     -Wno-maybe-uninitialized)
+  target_link_options(neuflow_options INTERFACE -fsanitize=address,undefined)
+endif()
+
+if(NEUFLOW_FUZZ)
+  # Coverage feedback for libFuzzer and the sanitizers on everything of ours; the harness
+  # executables add -fsanitize=fuzzer themselves (tests/fuzz/CMakeLists.txt). No NDEBUG in the
+  # fuzz preset, so assertions (ours and toml++'s) stay live.
+  target_compile_options(neuflow_options INTERFACE
+    -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer
+    -fno-sanitize-recover=undefined)
   target_link_options(neuflow_options INTERFACE -fsanitize=address,undefined)
 endif()

@@ -23,6 +23,7 @@ packages=(
   opencv-doc                        # sample video (vtest.avi) for the quick-start job
   systemd                           # systemd-analyze verify of the unit files
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang-14 libclang-rt-14-dev libomp-14-dev llvm-14   # libFuzzer harnesses (tests/fuzz), llvm-symbolizer
   python3 python3-numpy             # tests check that numpy reads our .npy files
 )
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <vector>
 
 namespace neuflow::daemon {
 namespace {
@@ -61,26 +62,53 @@ enum class Context {
   multiline_literal,  // '''...'''
 };
 
+// Where in a statement the code is, as far as telling strings from other quotes goes.
+enum class Part {
+  key,     // a key, up to its '=' (also the keys of inline tables)
+  header,  // inside a [table] or [[array]] header
+  value,   // after '='
+};
+
+bool bare_key_character(char32_t c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+}
+
 }  // namespace
 
 std::optional<TextProblem> check_config_text(std::string_view text) {
   int line = 1;
   int column = 1;
   Context context = Context::code;
-  // After a line-ending backslash in a multi-line basic string, until the next character that
-  // is not whitespace: toml++ 3.3.0 classifies that character with its whitespace tables.
+  // The code's grammar, just enough to know where a quote opens a string (toml++ 3.3.0 scans
+  // a value that does not start with a quote as code, so `x = 1.5"é"` holds no string), and to
+  // reject what its asserts assume away: a table header that does not start with a key, an
+  // array element that starts with '}'.
+  Part part = Part::key;
+  std::vector<char> open;  // '[' arrays and '{' inline tables of the value being read
+  char32_t previous = 0;   // the last code character
+  int header_brackets = 0;
+  bool statement_start = true;  // nothing but blanks and comments since the last statement
+  bool starts_key = true;       // the next code character begins a key
+  bool starts_value = false;    // the next code character begins a value
+  // After a backslash and blanks in a multi-line basic string (a line-ending backslash), until
+  // the next character that is not blank: toml++ 3.3.0 classifies it with its whitespace tables.
   bool continuation = false;
   const auto problem = [&](std::string message) { return TextProblem{line, column, std::move(message)}; };
-  const auto starts = [&](std::size_t at, std::string_view s) { return text.substr(std::min(at, text.size()), s.size()) == s; };
+  const auto starts = [&](std::size_t at, std::string_view s) {
+    return text.substr(std::min(at, text.size()), s.size()) == s;
+  };
   // An ASCII character that may follow a backslash as the second half of an escape pair.
   const auto escapable = [&](std::size_t at) { return at < text.size() && text[at] >= 0x20 && text[at] < 0x7F; };
+  const auto ascii_after = [&](std::size_t at) {
+    return at >= text.size() || static_cast<unsigned char>(text[at]) < 0x80;
+  };
   // Up to two quotes more may still belong to a multi-line string ("""a""""" ends in a"").
   const auto closing_length = [&](std::size_t at, char quote) {
     std::size_t n = 3;
     while (n < 5 && at + n < text.size() && text[at + n] == quote) ++n;
     return n;
   };
-
+  const auto in_array = [&] { return !open.empty() && open.back() == '['; };
   std::size_t i = starts(0, "\xEF\xBB\xBF") ? 3 : 0;  // a byte-order mark
   while (i < text.size()) {
     char32_t c = 0;
@@ -92,6 +120,21 @@ std::optional<TextProblem> check_config_text(std::string_view text) {
       // An unterminated single-line string is toml++'s to report, in its words.
       if (context == Context::comment || context == Context::basic_string || context == Context::literal_string) {
         context = Context::code;
+      }
+      if (context == Context::code && part == Part::header && starts_key) {
+        return problem("expected a key after '" + std::string(1, static_cast<char>(previous)) +
+                       "' in the table header, found the end of the line");
+      }
+      if (context == Context::code && open.empty() && part != Part::key) {  // a new statement
+        part = Part::key;
+        previous = 0;
+        header_brackets = 0;
+        statement_start = starts_key = true;
+        starts_value = false;
+      } else if (context == Context::code && open.empty() && part == Part::key && !starts_value) {
+        // A key that did not end with '=' is toml++'s to report; the next line starts anew.
+        previous = 0;
+        statement_start = starts_key = true;
       }
       ++line, ++i;
       column = 1;
@@ -113,8 +156,8 @@ std::optional<TextProblem> check_config_text(std::string_view text) {
     if (continuation) {
       if (c >= 0x80) {
         return problem("non-ASCII character " + code_point(c) +
-                       " right after a line-ending backslash in a multi-line string; begin the line with an "
-                       "ASCII character or remove the backslash");
+                       " right after a backslash and blanks in a multi-line string; begin with an ASCII "
+                       "character there or remove the backslash");
       }
       if (c != ' ' && c != '\t') continuation = false;
     }
@@ -122,22 +165,76 @@ std::optional<TextProblem> check_config_text(std::string_view text) {
     std::size_t bytes = length;  // consumed by this step
     int characters = 1;
     switch (context) {
-      case Context::code:
+      case Context::code: {
+        if (c == ' ' || c == '\t') break;
+        const bool key_start = starts_key, value_start = starts_value;
+        starts_key = starts_value = false;
+        // Before comments: toml++ asserts on a '#' there too.
+        if (part == Part::header && key_start && !bare_key_character(c) && c != '"' && c != '\'' &&
+            !(c == ']' && previous == '[') && !(c == '[' && header_brackets == 1 && text[i - 1] == '[')) {
+          return problem("expected a key after '" + std::string(1, static_cast<char>(previous)) +
+                         "' in the table header");
+        }
+        if (value_start && in_array() && c == '}') {
+          return problem("expected a value or ']' in the array, found '}'");
+        }
         if (c == '#') {
           context = Context::comment;
-        } else if (starts(i, R"(""")")) {
-          context = Context::multiline_basic, bytes = 3, characters = 3;
-        } else if (starts(i, "'''")) {
-          context = Context::multiline_literal, bytes = 3, characters = 3;
-        } else if (c == '"') {
-          context = Context::basic_string;
-        } else if (c == '\'') {
-          context = Context::literal_string;
+          starts_key = key_start, starts_value = value_start;  // a comment does not end the wait
+          break;
         }
+        if ((c == '"' || c == '\'') && (key_start || value_start)) {
+          const char quote = static_cast<char>(c);
+          if (starts(i, std::string(3, quote))) {
+            context = quote == '"' ? Context::multiline_basic : Context::multiline_literal;
+            bytes = 3, characters = 3;
+          } else {
+            context = quote == '"' ? Context::basic_string : Context::literal_string;
+          }
+          previous = c;
+          break;
+        }
+        if (statement_start && open.empty() && c == '[') {
+          part = Part::header;
+          header_brackets = 1;
+          starts_key = true;
+        } else if (part == Part::header && c == '[' && header_brackets == 1 && key_start && text[i - 1] == '[') {
+          header_brackets = 2;
+          starts_key = true;
+        } else if ((part == Part::key || part == Part::header) && c == '.') {
+          starts_key = true;
+        } else if (part == Part::key && c == '=') {
+          part = Part::value;
+          starts_value = true;
+        } else if (part == Part::value && value_start && c == '[') {
+          open.push_back('[');
+          starts_value = true;
+        } else if (part == Part::value && value_start && c == '{') {
+          open.push_back('{');
+          part = Part::key;
+          starts_key = true;
+        } else if (c == ']' && part == Part::value && in_array()) {
+          open.pop_back();
+        } else if (c == '}' && !open.empty() && open.back() == '{') {
+          open.pop_back();
+          part = Part::value;
+        } else if (c == ',' && part == Part::value && in_array()) {
+          starts_value = true;
+        } else if (c == ',' && part == Part::value && !open.empty() && open.back() == '{') {
+          part = Part::key;
+          starts_key = true;
+        }
+        statement_start = false;
+        previous = c;
         break;
+      }
       case Context::comment:
         break;
       case Context::basic_string:
+        if (c == '\\' && !ascii_after(i + 1)) {
+          ++column;
+          return problem("non-ASCII character after a backslash: not an escape sequence (write \\\\ for a backslash)");
+        }
         if (c == '\\' && escapable(i + 1)) {
           bytes = 2, characters = 2;
         } else if (c == '"') {
@@ -151,8 +248,14 @@ std::optional<TextProblem> check_config_text(std::string_view text) {
         if (c == '\\') {
           std::size_t k = i + 1;
           while (k < text.size() && (text[k] == ' ' || text[k] == '\t')) ++k;
-          if (k == text.size() || text[k] == '\n' || text[k] == '\r') {
+          if (k == text.size() || text[k] == '\n' || text[k] == '\r' || k > i + 1) {
+            // toml++ skips the blanks after the backslash (and the line end) and classifies the
+            // next character as whitespace or not.
             continuation = true;
+          } else if (!ascii_after(i + 1)) {
+            ++column;
+            return problem(
+                "non-ASCII character after a backslash: not an escape sequence (write \\\\ for a backslash)");
           } else if (escapable(i + 1)) {
             bytes = 2, characters = 2;
           }

@@ -41,7 +41,8 @@ TEST(ConfigText, NonAsciiAfterALineEndingBackslashIsAnError) {
   // marzer/tomlplusplus #190.
   const auto issues = issues_of("s = \"\"\"\\\n\xc2\xa7\"\"\"\n");
   ASSERT_EQ(issues.size(), 1u) << test::listed(issues);
-  EXPECT_TRUE(has_issue(issues, 2, 1, "right after a line-ending backslash"));
+  EXPECT_TRUE(has_issue(issues, 2, 1, "right after a backslash and blanks"));
+  EXPECT_TRUE(has_issue(issues_of("\"\"\"\"\\\t\xef\xb9\xbf"), 1, 7, "right after a backslash and blanks"));
 }
 
 TEST(ConfigText, ACombiningMarkAtTheTopLevelIsAnError) {
@@ -49,6 +50,44 @@ TEST(ConfigText, ACombiningMarkAtTheTopLevelIsAnError) {
   const auto issues = issues_of("\xcc\xaa");
   ASSERT_EQ(issues.size(), 1u) << test::listed(issues);
   EXPECT_TRUE(has_issue(issues, 1, 1, "non-ASCII character U+032A"));
+}
+
+// Found by tests/fuzz (fuzz_config) in toml++ 3.3.0; kept in tests/fuzz/regressions/config/.
+TEST(ConfigText, AQuoteInsideABareValueOpensNoString) {
+  // toml++ scans `1"é` as one bare value and classifies the é as possible whitespace: UB.
+  EXPECT_TRUE(has_issue(issues_of("e=1\"\xc3\xa9"), 1, 5, "non-ASCII character U+00E9 outside a string"));
+  EXPECT_TRUE(has_issue(issues_of("b = 1.5\"\xc3\xa9\""), 1, 9, "non-ASCII character U+00E9 outside a string"));
+}
+
+TEST(ConfigText, NonAsciiAfterABackslashInABasicStringIsAnError) {
+  EXPECT_TRUE(has_issue(issues_of("\"\"\"\\\xcd\xbf"), 1, 5, "non-ASCII character after a backslash"));
+  EXPECT_TRUE(has_issue(issues_of("a = \"\"\"\\\xcd\xbf\"\"\"\n"), 1, 9, "non-ASCII character after a backslash"));
+  EXPECT_TRUE(has_issue(issues_of("a = \"\\\xc3\xa9\"\n"), 1, 7, "non-ASCII character after a backslash"));
+}
+
+TEST(ConfigText, ATableHeaderMustStartWithAKey) {
+  for (const std::string bad : {"[!", "[[!", "[ #", "[\t=", "[a.,]", "[\n", "[a.\r\n", "[[ \n"}) {
+    const auto issues = issues_of(bad);
+    ASSERT_EQ(issues.size(), 1u) << bad << test::listed(issues);
+    EXPECT_NE(issues[0].message.find("expected a key after"), std::string::npos) << bad << test::listed(issues);
+  }
+}
+
+TEST(ConfigText, AnArrayElementCannotStartWithAClosingBrace) {
+  EXPECT_TRUE(has_issue(issues_of("e=[}"), 1, 4, "expected a value or ']' in the array, found '}'"));
+  EXPECT_TRUE(has_issue(issues_of("a = [1,}"), 1, 8, "found '}'"));
+  EXPECT_TRUE(has_issue(issues_of("a = { b = [ # comment\n }"), 2, 2, "found '}'"));
+}
+
+TEST(ConfigText, ValidTomlStaysAccepted) {
+  for (const std::string good :
+       {"a = [ { b = \"\xc3\xa9\" }, { \"\xc3\xa9\" = [ '\xc3\xa9', \"x\" ] } ]\n",
+        "[a . \"\xc3\xa9\"]\nk.\"\xc3\xa9\" = 1\n\"\xc3\xa9\" = 2\n",
+        "[[ \"\xc3\xa9\" ]]\nx = [\n  \"\xc3\xa9\",  # \xc3\xa9\n  [\"\xc3\xa9\"],\n]\n",
+        "d = 1979-05-27T07:32:00Z\nf = -1.5e3\ns = \"a\\\"\xc3\xa9\"\nt = \"\"\"\n\xc3\xa9\\\"\"\"\"\n",
+        "e = {}\nf = []\ng = [[1, 2], [3]]\n"}) {
+    EXPECT_FALSE(check_config_text(good)) << good << ": " << check_config_text(good)->message;
+  }
 }
 
 TEST(ConfigText, MalformedUtf8IsAnError) {
