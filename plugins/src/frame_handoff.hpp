@@ -123,11 +123,11 @@ class FrameHandoff {
   }
 
   // The consumer could not pass an item on (`code` != 0, e.g. a GstFlowReturn): producers'
-  // frame pushes fail with Result::failed from now on; failure() tells them the code.
+  // frame pushes fail with Result::failed from now on; failure() tells them the first code.
   void fail(int code) {
     {
       const std::lock_guard lock(mutex_);
-      failure_ = code;
+      if (failure_ == 0) failure_ = code;
     }
     not_full_.notify_all();
     idle_.notify_all();

@@ -132,6 +132,10 @@ struct State {
   Handoff output{kResultsWaiting};
   GstTask *inference = nullptr;  // owned; runs inference_loop
   GRecMutex inference_lock;      // held by the task while it runs an iteration
+  // Serializes what starts, pauses and stops the two tasks (activation, flushes): a flush that
+  // races with the src pad's deactivation must not restart tasks that are being stopped.
+  std::mutex tasks_lock;
+  bool active = false;  // the src pad is active and its tasks are ours to pause and restart
 
   std::mutex lock;                   // guards what follows, up to the worker-only state
   std::optional<bool> live;          // resolved from the behaviour and upstream's liveness
@@ -208,7 +212,8 @@ Settings copy_settings(GstNeuflow *self) {
   return s;
 }
 
-// Stops the inference worker and waits for the item it is computing, if any.
+// Pauses the inference worker and waits until it has: a started task holds its lock until it
+// pauses, and the worker pauses itself at the next flush it sees.
 void pause_inference(State &st) {
   gst_task_pause(st.inference);
   g_rec_mutex_lock(&st.inference_lock);
@@ -399,18 +404,21 @@ void inference_loop(gpointer data) {
         ret = GST_FLOW_NOT_NEGOTIATED;
       }
     }
-    if (st.output.push_other(item) != Handoff::Result::queued) gst_event_unref(item.event);
+    if (ret != GST_FLOW_OK || st.output.push_other(item) != Handoff::Result::queued) gst_event_unref(item.event);
   }
-  st.input.done();
   if (ret != GST_FLOW_OK) {
     // Our own failure (already posted as an element error): upstream learns it at its next
-    // frame, downstream gets an end of stream after what was computed before.
+    // frame, downstream gets an end of stream after what was computed before. Recorded before
+    // done(), so that a drain waiting on `input` sees the failure, not an idle worker.
     GST_DEBUG_OBJECT(self, "pausing inference: %s", gst_flow_get_name(ret));
     st.input.fail(ret);
     Item eos{nullptr, gst_event_new_eos(), 0};
     if (st.output.push_other(eos) != Handoff::Result::queued) gst_event_unref(eos.event);
+    st.input.done();
     gst_task_pause(st.inference);
+    return;
   }
+  st.input.done();
 }
 
 // The src pad's task: pushes the worker's results downstream, in order.
@@ -517,12 +525,23 @@ gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
     case GST_EVENT_FLUSH_START: {
       release_all(st.input.start_flushing());
       release_all(st.output.start_flushing());
-      const gboolean ok = gst_pad_push_event(self->srcpad, event);
-      gst_pad_pause_task(self->srcpad);  // returns once the push thread finished its current item
-      pause_inference(st);               // returns once the worker finished its current item
+      const gboolean ok = gst_pad_push_event(self->srcpad, event);  // unblocks a sink holding the push thread
+      const std::lock_guard tasks(st.tasks_lock);
+      if (st.active) {
+        gst_pad_pause_task(self->srcpad);  // returns once the push thread finished its current item
+        pause_inference(st);               // returns once the worker finished its current item
+      }
       return ok;
     }
     case GST_EVENT_FLUSH_STOP: {
+      const std::lock_guard tasks(st.tasks_lock);
+      if (!st.active) return gst_pad_push_event(self->srcpad, event);  // being stopped: stays flushing
+      // Paused again (idempotent): a FLUSH_STOP may come without its FLUSH_START, and a worker
+      // that saw the flush must not pause itself after the restart below.
+      release_all(st.input.start_flushing());
+      release_all(st.output.start_flushing());
+      gst_pad_pause_task(self->srcpad);
+      pause_inference(st);
       // Both threads are paused: the worker-only state is ours.
       release_all(st.input.start_flushing());
       release_all(st.output.start_flushing());
@@ -605,22 +624,28 @@ gboolean src_activate_mode(GstPad *pad, GstObject *parent, GstPadMode mode, gboo
   auto *self = GST_NEUFLOW(parent);
   State &st = *self->state;
   if (mode != GST_PAD_MODE_PUSH) return FALSE;
+  const std::lock_guard tasks(st.tasks_lock);
   if (active) {
     st.input.stop_flushing();
     st.output.stop_flushing();
-    if (!gst_task_start(st.inference)) return FALSE;
-    return gst_pad_start_task(pad, push_loop, self, nullptr);
+    if (gst_task_start(st.inference) && gst_pad_start_task(pad, push_loop, self, nullptr)) {
+      st.active = true;
+      return TRUE;
+    }
   }
+  // Deactivation, or an activation that could not start both tasks: both stopped and joined.
+  st.active = false;
   release_all(st.input.start_flushing());
   release_all(st.output.start_flushing());
   const gboolean stopped = gst_pad_stop_task(pad);
-  // Stopped while no iteration runs (the task holds this lock during one), so that the worker
-  // cannot pause the task again after the stop and leave the join waiting.
+  // A started task holds its lock until it pauses: the worker pauses itself once it sees the
+  // flush. Stopped under the lock, it cannot pause itself again after the stop, which would
+  // leave the join waiting.
   g_rec_mutex_lock(&st.inference_lock);
   gst_task_stop(st.inference);
   g_rec_mutex_unlock(&st.inference_lock);
   gst_task_join(st.inference);
-  return stopped;
+  return active ? FALSE : stopped;
 }
 
 // ---- lifecycle -----------------------------------------------------------------------------

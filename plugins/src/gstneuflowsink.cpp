@@ -262,6 +262,24 @@ static void gst_neuflow_sink_finalize(GObject *object) {
   G_OBJECT_CLASS(gst_neuflow_sink_parent_class)->finalize(object);
 }
 
+// Deletes the oldest files until max-files and max-bytes hold. A file that cannot be deleted is
+// a warning: what was written stays written.
+static void gst_neuflow_sink_remove_excess(GstNeuflowSink *self, guint64 max_files, guint64 max_bytes) {
+  for (const std::string &old : self->written->take_excess(max_files, max_bytes)) {
+    ++self->files_removed;
+    if (std::remove(old.c_str()) != 0 && errno != ENOENT) {
+      const int err = errno;
+      GST_ELEMENT_WARNING(self, RESOURCE, WRITE,
+                          ("Could not delete the old flow file \"%s\" (max-files=%" G_GUINT64_FORMAT
+                           ", max-bytes=%" G_GUINT64_FORMAT "): %s.",
+                           old.c_str(), max_files, max_bytes, g_strerror(err)),
+                          (nullptr));
+    } else {
+      GST_LOG_OBJECT(self, "deleted %s", old.c_str());
+    }
+  }
+}
+
 // What earlier runs left: the temporaries of writes a crash interrupted go, and with a limit
 // set, the files the pattern names count towards it (oldest index first), so a restarted or
 // reconfigured stream holds max-files / max-bytes over everything in the folder.
@@ -275,19 +293,7 @@ static void gst_neuflow_sink_take_over_earlier_files(GstNeuflowSink *self) {
   GST_OBJECT_UNLOCK(self);
   if (max_files == 0 && max_bytes == 0) return;
   for (const auto &file : neuflow::gst::files_matching(self->pattern)) self->written->add(file.path, file.bytes);
-  for (const std::string &old : self->written->take_excess(max_files, max_bytes)) {
-    ++self->files_removed;  // the index is compacted at the latest when the sink stops
-    if (std::remove(old.c_str()) != 0 && errno != ENOENT) {
-      const int err = errno;
-      GST_ELEMENT_WARNING(self, RESOURCE, WRITE,
-                          ("Could not delete the old flow file \"%s\" (max-files=%" G_GUINT64_FORMAT
-                           ", max-bytes=%" G_GUINT64_FORMAT "): %s.",
-                           old.c_str(), max_files, max_bytes, g_strerror(err)),
-                          (nullptr));
-    } else {
-      GST_LOG_OBJECT(self, "deleted %s, left by an earlier run", old.c_str());
-    }
-  }
+  gst_neuflow_sink_remove_excess(self, max_files, max_bytes);  // compacted at the latest at stop
 }
 
 // Validates the settings and checks that the output directories exist, so that a typo shows
@@ -391,19 +397,7 @@ static void gst_neuflow_sink_apply_retention(GstNeuflowSink *self, const std::st
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::file_size(path, ec);
   self->written->add(path, ec ? 0 : static_cast<std::uint64_t>(size));
-  for (const std::string &old : self->written->take_excess(max_files, max_bytes)) {
-    ++self->files_removed;
-    if (std::remove(old.c_str()) != 0 && errno != ENOENT) {
-      const int err = errno;
-      GST_ELEMENT_WARNING(self, RESOURCE, WRITE,
-                          ("Could not delete the old flow file \"%s\" (max-files=%" G_GUINT64_FORMAT
-                           ", max-bytes=%" G_GUINT64_FORMAT "): %s.",
-                           old.c_str(), max_files, max_bytes, g_strerror(err)),
-                          (nullptr));
-    } else {
-      GST_LOG_OBJECT(self, "deleted %s", old.c_str());
-    }
-  }
+  gst_neuflow_sink_remove_excess(self, max_files, max_bytes);
 
   if (!self->index_path) return;
   if (!self->index_rows_known) {

@@ -313,8 +313,12 @@ TEST_F(NeuflowElement, LiveRunStaysBoundedInLatencyAndMemory) {
 // Double buffering: the next frame is computed while the last one waits in the sink's clock
 // sync, so a live pipeline without a queue after the element runs as fast as one with it.
 // Measured before: 2.85 flows/s without the queue against 6.4 with it (320x256 at 30 fps,
-// threads=2). Both are measured here, alternately, and compared (no absolute timing).
+// threads=2). Both are measured here, alternately, and compared (no absolute timing); ctest
+// runs this test alone (RUN_SERIAL, tests/plugin/CMakeLists.txt).
 TEST_F(NeuflowElement, WithoutAQueueALivePipelineKeepsTheRateOfOneWithAQueue) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "rates under the sanitizers say nothing; the release build runs this comparison";
+#endif
   const auto flows_per_second = [&](bool with_queue) {
     GError* err = nullptr;
     GstElement* pipeline = gst_parse_launch(
@@ -328,7 +332,11 @@ TEST_F(NeuflowElement, WithoutAQueueALivePipelineKeepsTheRateOfOneWithAQueue) {
     g_usleep(G_USEC_PER_SEC);  // first flows, latency announced and configured
     const guint64 before = uint64_property(nf, "flows");
     const gint64 start = g_get_monotonic_time();
-    g_usleep(3 * G_USEC_PER_SEC);
+    // At least 5 s and 25 flows (a slow machine would otherwise compare a handful), at most 15 s.
+    for (int waited_ms = 0; waited_ms < 15000; waited_ms += 100) {
+      if (waited_ms >= 5000 && uint64_property(nf, "flows") - before >= 25) break;
+      g_usleep(G_USEC_PER_SEC / 10);
+    }
     const double rate = static_cast<double>(uint64_property(nf, "flows") - before) /
                         (static_cast<double>(g_get_monotonic_time() - start) / G_USEC_PER_SEC);
     gst_element_set_state(pipeline, GST_STATE_NULL);
