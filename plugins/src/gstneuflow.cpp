@@ -486,28 +486,33 @@ GstFlowReturn sink_chain(GstPad * /*pad*/, GstObject *parent, GstBuffer *buffer)
     st.live = live = resolved;
   }
 
-  guint64 frame = 0;
-  {
+  // Newest wins when live: a frame still waiting for the worker is replaced by this one (the
+  // hand-off never waits then, so it happens under the counters' lock and they never show a
+  // frame in that is neither waiting, computed nor dropped); its QoS message is posted after.
+  // Every pair: wait for room, outside the lock.
+  Item item{buffer, nullptr, 0};
+  std::vector<Item> dropped;
+  Handoff::Result queued;
+  guint64 processed = 0, drops = 0;
+  GstSegment segment{};
+  if (*live) {
     const std::lock_guard lock(st.lock);
     ++st.stats.frames_in;
-    frame = st.next_frame++;
-  }
-  // Newest wins when live: a frame still waiting for the worker is replaced by this one, and
-  // its QoS message is posted here, after the hand-off. Every pair: wait for room.
-  Item item{buffer, nullptr, frame};
-  std::vector<Item> dropped;
-  const auto queued = st.input.push_frame(
-      item, *live ? Handoff::Policy::newest_wins : Handoff::Policy::back_pressure, &dropped);
-  if (!dropped.empty()) {
-    guint64 processed = 0, drops = 0;
-    GstSegment segment{};
+    item.frame = st.next_frame++;
+    queued = st.input.push_frame(item, Handoff::Policy::newest_wins, &dropped);
+    st.stats.dropped += dropped.size();
+    processed = st.stats.processed;
+    drops = st.stats.dropped;
+    segment = st.segment;
+  } else {
     {
       const std::lock_guard lock(st.lock);
-      st.stats.dropped += dropped.size();
-      processed = st.stats.processed;
-      drops = st.stats.dropped;
-      segment = st.segment;
+      ++st.stats.frames_in;
+      item.frame = st.next_frame++;
     }
+    queued = st.input.push_frame(item, Handoff::Policy::back_pressure);
+  }
+  if (!dropped.empty()) {
     for (Item &old : dropped) {
       post_drop(self, old.buffer, segment, processed, drops);
       release(old);
