@@ -212,6 +212,12 @@ Settings copy_settings(GstNeuflow *self) {
   return s;
 }
 
+// Both hand-offs refuse new items and wake their waiters; what was waiting is released.
+void flush_handoffs(State &st) {
+  release_all(st.input.start_flushing());
+  release_all(st.output.start_flushing());
+}
+
 // Pauses the inference worker and waits until it has: a started task holds its lock until it
 // pauses, and the worker pauses itself at the next flush it sees.
 void pause_inference(State &st) {
@@ -528,8 +534,7 @@ gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
   State &st = *self->state;
   switch (GST_EVENT_TYPE(event)) {
     case GST_EVENT_FLUSH_START: {
-      release_all(st.input.start_flushing());
-      release_all(st.output.start_flushing());
+      flush_handoffs(st);
       const gboolean ok = gst_pad_push_event(self->srcpad, event);  // unblocks a sink holding the push thread
       const std::lock_guard tasks(st.tasks_lock);
       if (st.active) {
@@ -543,13 +548,10 @@ gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
       if (!st.active) return gst_pad_push_event(self->srcpad, event);  // being stopped: stays flushing
       // Paused again (idempotent): a FLUSH_STOP may come without its FLUSH_START, and a worker
       // that saw the flush must not pause itself after the restart below.
-      release_all(st.input.start_flushing());
-      release_all(st.output.start_flushing());
+      flush_handoffs(st);
       gst_pad_pause_task(self->srcpad);
       pause_inference(st);
-      // Both threads are paused: the worker-only state is ours.
-      release_all(st.input.start_flushing());
-      release_all(st.output.start_flushing());
+      // Both threads are paused and nothing was queued since: the worker-only state is ours.
       st.input.stop_flushing();
       st.output.stop_flushing();
       if (st.session) st.session->reset();
@@ -640,8 +642,7 @@ gboolean src_activate_mode(GstPad *pad, GstObject *parent, GstPadMode mode, gboo
   }
   // Deactivation, or an activation that could not start both tasks: both stopped and joined.
   st.active = false;
-  release_all(st.input.start_flushing());
-  release_all(st.output.start_flushing());
+  flush_handoffs(st);
   const gboolean stopped = gst_pad_stop_task(pad);
   // A started task holds its lock until it pauses: the worker pauses itself once it sees the
   // flush. Stopped under the lock, it cannot pause itself again after the stop, which would
@@ -781,8 +782,7 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
 
 void finalize(GObject *object) {
   auto *self = GST_NEUFLOW(object);
-  release_all(self->state->input.start_flushing());
-  release_all(self->state->output.start_flushing());
+  flush_handoffs(*self->state);
   gst_object_unref(self->state->inference);
   g_rec_mutex_clear(&self->state->inference_lock);
   if (self->state->converter) gst_video_converter_free(self->state->converter);
@@ -893,8 +893,7 @@ static void gst_neuflow_init(GstNeuflow *self) {
   self->state = new State();
   gst_segment_init(&self->state->segment, GST_FORMAT_TIME);
   // Flushing until the src pad is activated.
-  release_all(self->state->input.start_flushing());
-  release_all(self->state->output.start_flushing());
+  flush_handoffs(*self->state);
   g_rec_mutex_init(&self->state->inference_lock);
   self->state->inference = gst_task_new(inference_loop, self, nullptr);
   gst_task_set_lock(self->state->inference, &self->state->inference_lock);
