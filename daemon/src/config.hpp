@@ -13,6 +13,8 @@
 #include <variant>
 #include <vector>
 
+#include "neuflow/model/session_settings.hpp"
+
 namespace neuflow::daemon {
 
 struct SourcePosition {
@@ -71,8 +73,8 @@ struct SourceConfig {
 // The neuflow element's properties, under the same names in the file.
 struct FlowConfig {
   std::filesystem::path model;   // model = "/var/lib/neuflow/neuflow_mixed.pth" (required)
-  int iters_s16 = 1;             // iters-s16
-  int iters_s8 = 8;              // iters-s8
+  int iters_s16 = model::Iterations{}.s16;  // iters-s16
+  int iters_s8 = model::Iterations{}.s8;    // iters-s8
   int model_width = 0;           // model-width / model-height: 0 = the frames' own size
   int model_height = 0;
   int threads = 0;               // 0: an equal share of [daemon] threads

@@ -5,14 +5,13 @@
 #include "config_elements.hpp"
 #include "config_read.hpp"
 #include "config_values.hpp"
+#include "neuflow/model/session_settings.hpp"
 
 namespace neuflow::daemon {
 namespace {
 
 using Need = TableReader::Need;
-
-// The network runs on multiples of 16 (the 1/16 feature map); below 32 nothing is left of it.
-bool valid_model_side(std::int64_t side) { return side >= 32 && side % 16 == 0; }
+using SessionLimits = model::SessionLimits;
 
 }  // namespace
 
@@ -20,7 +19,8 @@ FlowConfig read_flow(const TableReader& t, ReadContext& context) {
   static constexpr std::array<std::string_view, 8> keys = {"model",        "iters-s16", "iters-s8",  "model-width",
                                                            "model-height", "threads",   "behaviour", "channel-order"};
   static constexpr std::array<std::string_view, 3> behaviours = {"auto", "live", "every-pair"};
-  static constexpr std::array<std::string_view, 2> orders = {"rgb", "bgr"};
+  static constexpr std::array<std::string_view, 2> orders = {model::channel_order_name(model::ChannelOrder::rgb),
+                                                             model::channel_order_name(model::ChannelOrder::bgr)};
   t.allow_only(keys);
   FlowConfig f;
   f.where = t.where();
@@ -31,15 +31,16 @@ FlowConfig read_flow(const TableReader& t, ReadContext& context) {
       f.model = context.need_path(PathNeed::Kind::readable_file, *model, "model", t.position("model"));
     }
   }
-  if (auto v = t.integer("iters-s16", 0, 32)) f.iters_s16 = static_cast<int>(*v);
-  if (auto v = t.integer("iters-s8", 0, 64)) f.iters_s8 = static_cast<int>(*v);
-  const auto width = t.integer("model-width", 0, 16384);
-  const auto height = t.integer("model-height", 0, 16384);
-  const std::string side_expected = "a multiple of 16, at least 32 (or 0 for the frames' own size)";
-  if (width && *width != 0 && !valid_model_side(*width)) {
-    t.report("model-width", "expected " + side_expected + ", got " + std::to_string(*width));
-  } else if (height && *height != 0 && !valid_model_side(*height)) {
-    t.report("model-height", "expected " + side_expected + ", got " + std::to_string(*height));
+  if (auto v = t.integer("iters-s16", 0, SessionLimits::max_iterations_s16)) f.iters_s16 = static_cast<int>(*v);
+  if (auto v = t.integer("iters-s8", 0, SessionLimits::max_iterations_s8)) f.iters_s8 = static_cast<int>(*v);
+  const auto width = t.integer("model-width", 0, SessionLimits::max_side);
+  const auto height = t.integer("model-height", 0, SessionLimits::max_side);
+  const auto width_problem = width ? model::check_model_side(static_cast<int>(*width)) : std::nullopt;
+  const auto height_problem = height ? model::check_model_side(static_cast<int>(*height)) : std::nullopt;
+  if (width_problem) {
+    t.report("model-width", *width_problem);
+  } else if (height_problem) {
+    t.report("model-height", *height_problem);
   } else if (width && height) {
     if ((*width == 0) != (*height == 0)) {
       t.report(*width == 0 ? "model-width" : "model-height",
@@ -51,7 +52,7 @@ FlowConfig read_flow(const TableReader& t, ReadContext& context) {
     t.report(width ? "model-width" : "model-height",
              std::string("model-width and model-height go together: add ") + (width ? "model-height" : "model-width"));
   }
-  if (auto v = t.integer("threads", 0, 1024)) f.threads = static_cast<int>(*v);
+  if (auto v = t.integer("threads", 0, SessionLimits::max_threads)) f.threads = static_cast<int>(*v);
   if (auto v = t.choice("behaviour", behaviours)) f.behaviour = *v;
   if (auto v = t.choice("channel-order", orders)) f.channel_order = *v;
   return f;

@@ -25,9 +25,8 @@ struct FlowSession::State {
 namespace {
 
 void validate(const Iterations& it) {
-  if (it.s16 < 0 || it.s8 < 0 || it.s16 > 32 || it.s8 > 64) {
-    throw std::invalid_argument("iterations must be 0..32 at 1/16 and 0..64 at 1/8");
-  }
+  if (auto problem = check_iterations_s16(it.s16)) throw std::invalid_argument("iters-s16: " + *problem);
+  if (auto problem = check_iterations_s8(it.s8)) throw std::invalid_argument("iters-s8: " + *problem);
 }
 
 }  // namespace
@@ -35,8 +34,7 @@ void validate(const Iterations& it) {
 FlowSession::FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions options)
     : options_(options), model_(std::move(model)), state_(std::make_unique<State>()) {
   if (!model_) throw std::invalid_argument("FlowSession needs a loaded model");
-  if (options_.threads < 0) throw std::invalid_argument("threads must be 0 (all cores) or positive");
-  validate(options_.iterations);
+  if (auto problem = check_session_options(options_)) throw std::invalid_argument(*problem);
 }
 
 FlowSession::~FlowSession() = default;
@@ -81,9 +79,9 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   apply_threads(options_.threads);
   auto& s = *state_;
   const FrameGeometry& g = prepare_plan(s, model_->weights(), options_, frame0.width, frame0.height);
-  prepare_input(frame0, g, s.input);
+  prepare_input(frame0, g, options_.network_order, s.input);
   s.plan->encode(s.stream, s.input, s.pair_first);
-  prepare_input(frame1, g, s.input);
+  prepare_input(frame1, g, options_.network_order, s.input);
   s.plan->encode(s.stream, s.input, s.pair_second);
   s.plan->flow(s.stream, s.pair_first, s.pair_second, iterations.s16, iterations.s8, s.model_flow, &s.observer);
   return restore_flow(s.model_flow, g);
@@ -96,7 +94,7 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   apply_threads(options_.threads);
   auto& s = *state_;
   const FrameGeometry& g = prepare_plan(s, model_->weights(), options_, frame.width, frame.height);
-  prepare_input(frame, g, s.input);
+  prepare_input(frame, g, options_.network_order, s.input);
   s.plan->encode(s.stream, s.input, s.current);
   std::optional<flow::FlowField> result;
   if (s.has_previous) {

@@ -8,59 +8,48 @@
 
 namespace neuflow::model {
 
-namespace {
-constexpr int kMultiple = 16;
-constexpr int kMinSize = 32;
-constexpr int kMaxSize = 16384;
-
-int round_up(int v, int m) { return (v + m - 1) / m * m; }
-}  // namespace
-
 FrameGeometry plan_geometry(int input_width, int input_height, const SessionOptions& options) {
-  if (input_width < kMinSize || input_height < kMinSize || input_width > kMaxSize || input_height > kMaxSize) {
+  using L = SessionLimits;
+  if (input_width < L::min_side || input_height < L::min_side || input_width > L::max_side ||
+      input_height > L::max_side) {
     throw std::invalid_argument("frame size " + std::to_string(input_width) + "x" + std::to_string(input_height) +
                                 " is outside the supported range 32x32 to 16384x16384");
   }
   FrameGeometry g;
   g.input_width = input_width;
   g.input_height = input_height;
-  if (options.model_width > 0 || options.model_height > 0) {
-    if (options.model_width % kMultiple || options.model_height % kMultiple || options.model_width < kMinSize ||
-        options.model_height < kMinSize || options.model_width > kMaxSize || options.model_height > kMaxSize) {
-      throw std::invalid_argument("model size " + std::to_string(options.model_width) + "x" +
-                                  std::to_string(options.model_height) +
-                                  " must be multiples of 16, at least 32x32 (or 0x0 for the input's own size)");
-    }
-    g.resize = true;
-    g.model_width = options.model_width;
-    g.model_height = options.model_height;
-  } else {
-    g.model_width = round_up(input_width, kMultiple);
-    g.model_height = round_up(input_height, kMultiple);
+  if (auto problem = check_model_size(options.model_width, options.model_height)) {
+    throw std::invalid_argument(*problem);
+  }
+  const ModelSize size = model_size_for(input_width, input_height, options);
+  g.model_width = size.width;
+  g.model_height = size.height;
+  g.resize = options.model_width > 0;
+  if (!g.resize) {
     g.pad_left = (g.model_width - input_width) / 2;
     g.pad_top = (g.model_height - input_height) / 2;
   }
   return g;
 }
 
-void prepare_input(const ImageView& image, const FrameGeometry& g, Tensor& out) {
+void prepare_input(const ImageView& image, const FrameGeometry& g, ChannelOrder network_order, Tensor& out) {
   if (image.data == nullptr || image.width != g.input_width || image.height != g.input_height ||
       image.stride < static_cast<std::ptrdiff_t>(image.width) * 3) {
     throw std::invalid_argument("image does not match the session's frame size or has a short row stride");
   }
   const cv::Mat src(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.data),
                     static_cast<std::size_t>(image.stride));
-  cv::Mat rgb;
-  if (image.order == ChannelOrder::bgr) {
-    cv::cvtColor(src, rgb, cv::COLOR_BGR2RGB);
+  cv::Mat ordered;
+  if (image.order != network_order) {
+    cv::cvtColor(src, ordered, cv::COLOR_BGR2RGB);  // the same swap either way
   } else {
-    rgb = src;
+    ordered = src;
   }
   cv::Mat sized;
   if (g.resize) {
-    cv::resize(rgb, sized, cv::Size(g.model_width, g.model_height), 0, 0, cv::INTER_LINEAR);
+    cv::resize(ordered, sized, cv::Size(g.model_width, g.model_height), 0, 0, cv::INTER_LINEAR);
   } else {
-    cv::copyMakeBorder(rgb, sized, g.pad_top, g.model_height - g.input_height - g.pad_top, g.pad_left,
+    cv::copyMakeBorder(ordered, sized, g.pad_top, g.model_height - g.input_height - g.pad_top, g.pad_left,
                        g.model_width - g.input_width - g.pad_left, cv::BORDER_REPLICATE);
   }
   out.resize(g.model_height, g.model_width, 3);

@@ -19,8 +19,9 @@ struct FrameGeometry {
 // Throws std::invalid_argument when the size is below 32×32 or the model size is unusable.
 FrameGeometry plan_geometry(int input_width, int input_height, const SessionOptions& options);
 
-// The frame as the network's input: [model_height, model_width, 3], RGB in 0..1.
-void prepare_input(const ImageView& image, const FrameGeometry& geometry, Tensor& out);
+// The frame as the network's input: [model_height, model_width, 3] in 0..1, its channels in
+// `network_order` whatever order the image holds.
+void prepare_input(const ImageView& image, const FrameGeometry& geometry, ChannelOrder network_order, Tensor& out);
 
 // The network's flow [model_height, model_width, 2] as a flow field at the input's size.
 flow::FlowField restore_flow(const Tensor& model_flow, const FrameGeometry& geometry);

@@ -70,10 +70,9 @@ enum {
   PROP_PROCESSING_RATE,
 };
 
-constexpr guint DEFAULT_ITERS_S16 = 1;
-constexpr guint DEFAULT_ITERS_S8 = 8;
-constexpr guint DEFAULT_MODEL_SIZE = 0;
-constexpr guint DEFAULT_THREADS = 0;
+// The session's settings, defaults and limits are the model's (neuflow/model/session_settings.hpp).
+using SessionLimits = neuflow::model::SessionLimits;
+constexpr neuflow::model::SessionOptions DEFAULT_SESSION{};
 constexpr guint DEFAULT_STATS_INTERVAL = 1000;  // ms; 0 = no stats messages
 constexpr std::size_t kEveryPairQueuedBuffers = 2;
 // Results waiting for the push thread: one is enough to overlap a push with the next inference.
@@ -81,12 +80,7 @@ constexpr std::size_t kResultsWaiting = 1;
 
 struct Settings {
   std::string model;
-  guint iters_s16 = DEFAULT_ITERS_S16;
-  guint iters_s8 = DEFAULT_ITERS_S8;
-  guint model_width = DEFAULT_MODEL_SIZE;
-  guint model_height = DEFAULT_MODEL_SIZE;
-  guint threads = DEFAULT_THREADS;
-  ChannelOrder order = ChannelOrder::rgb;
+  neuflow::model::SessionOptions session = DEFAULT_SESSION;
   Behaviour behaviour = Behaviour::automatic;
   guint stats_interval = DEFAULT_STATS_INTERVAL;
 };
@@ -238,20 +232,15 @@ void post_stats(GstNeuflow *self, const Stats &s) {
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), st));
 }
 
-// Gives the frame to the session as RGB (or BGR when asked), converting other formats.
-neuflow::model::ImageView frame_view(State &st, GstVideoFrame &frame, ChannelOrder order) {
+// The frame as packed RGB or BGR for the session (which feeds the network the order its
+// options ask for), converting other formats.
+neuflow::model::ImageView frame_view(State &st, GstVideoFrame &frame) {
   const GstVideoFormat format = GST_VIDEO_INFO_FORMAT(&st.info);
   const int width = GST_VIDEO_INFO_WIDTH(&st.info), height = GST_VIDEO_INFO_HEIGHT(&st.info);
-  // BGR data claimed as BGR is swapped by the session; claiming the other order skips the
-  // swap, which is how the network is fed BGR on request.
-  const auto claim = [&](ChannelOrder data_order) {
-    return order == ChannelOrder::rgb ? data_order
-                                      : (data_order == ChannelOrder::rgb ? ChannelOrder::bgr : ChannelOrder::rgb);
-  };
   if (format == GST_VIDEO_FORMAT_RGB || format == GST_VIDEO_FORMAT_BGR) {
     return {static_cast<const std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 0)), width, height,
             GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 0),
-            claim(format == GST_VIDEO_FORMAT_RGB ? ChannelOrder::rgb : ChannelOrder::bgr)};
+            format == GST_VIDEO_FORMAT_RGB ? ChannelOrder::rgb : ChannelOrder::bgr};
   }
   GstVideoFrame out;
   GstVideoInfo rgb_info;
@@ -262,7 +251,7 @@ neuflow::model::ImageView frame_view(State &st, GstVideoFrame &frame, ChannelOrd
   gst_video_frame_map(&out, &rgb_info, wrapped, GST_MAP_WRITE);
   gst_video_converter_frame(st.converter, &frame, &out);
   const neuflow::model::ImageView view{st.rgb.data(), width, height, GST_VIDEO_FRAME_PLANE_STRIDE(&out, 0),
-                                       claim(ChannelOrder::rgb)};
+                                       ChannelOrder::rgb};
   gst_video_frame_unmap(&out);
   gst_buffer_unref(wrapped);
   return view;
@@ -314,7 +303,7 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
   const auto started = std::chrono::steady_clock::now();
   std::optional<neuflow::flow::FlowField> flow;
   try {
-    flow = st.session->push(frame_view(st, frame, settings.order));
+    flow = st.session->push(frame_view(st, frame));
   } catch (const std::exception &e) {
     gst_video_frame_unmap(&frame);
     gst_buffer_unref(buffer);
@@ -335,10 +324,11 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
     meta->from_frame = st.previous_frame;
     meta->to_frame = frame_number;
     const auto &opts = st.session->options();
-    meta->model_width = opts.model_width ? opts.model_width : (flow->width + 15) / 16 * 16;
-    meta->model_height = opts.model_height ? opts.model_height : (flow->height + 15) / 16 * 16;
-    meta->iters_s16 = settings.iters_s16;
-    meta->iters_s8 = settings.iters_s8;
+    const auto size = neuflow::model::model_size_for(flow->width, flow->height, opts);
+    meta->model_width = size.width;
+    meta->model_height = size.height;
+    meta->iters_s16 = opts.iterations.s16;
+    meta->iters_s8 = opts.iterations.s8;
     meta->inference_time = static_cast<GstClockTime>(seconds * GST_SECOND);
   }
   st.previous_pts = pts;
@@ -677,13 +667,8 @@ GstStateChangeReturn change_state(GstElement *element, GstStateChange transition
     }
     case GST_STATE_CHANGE_READY_TO_PAUSED: {
       const Settings s = copy_settings(self);
-      neuflow::model::SessionOptions options;
-      options.iterations = {static_cast<int>(s.iters_s16), static_cast<int>(s.iters_s8)};
-      options.model_width = static_cast<int>(s.model_width);
-      options.model_height = static_cast<int>(s.model_height);
-      options.threads = static_cast<int>(s.threads);
       try {
-        st.session = std::make_unique<FlowSession>(*self->model, options);
+        st.session = std::make_unique<FlowSession>(*self->model, s.session);
       } catch (const std::exception &e) {
         GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("invalid settings: %s", e.what()), (nullptr));
         return GST_STATE_CHANGE_FAILURE;
@@ -727,12 +712,13 @@ void set_property(GObject *object, guint id, const GValue *value, GParamSpec *ps
   Settings &s = *self->settings;
   switch (id) {
     case PROP_MODEL: s.model = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
-    case PROP_ITERS_S16: s.iters_s16 = g_value_get_uint(value); break;
-    case PROP_ITERS_S8: s.iters_s8 = g_value_get_uint(value); break;
-    case PROP_MODEL_WIDTH: s.model_width = g_value_get_uint(value); break;
-    case PROP_MODEL_HEIGHT: s.model_height = g_value_get_uint(value); break;
-    case PROP_THREADS: s.threads = g_value_get_uint(value); break;
-    case PROP_CHANNEL_ORDER: s.order = static_cast<ChannelOrder>(g_value_get_enum(value)); break;
+    // The param specs' ranges keep each value within int.
+    case PROP_ITERS_S16: s.session.iterations.s16 = static_cast<int>(g_value_get_uint(value)); break;
+    case PROP_ITERS_S8: s.session.iterations.s8 = static_cast<int>(g_value_get_uint(value)); break;
+    case PROP_MODEL_WIDTH: s.session.model_width = static_cast<int>(g_value_get_uint(value)); break;
+    case PROP_MODEL_HEIGHT: s.session.model_height = static_cast<int>(g_value_get_uint(value)); break;
+    case PROP_THREADS: s.session.threads = static_cast<int>(g_value_get_uint(value)); break;
+    case PROP_CHANNEL_ORDER: s.session.network_order = static_cast<ChannelOrder>(g_value_get_enum(value)); break;
     case PROP_BEHAVIOUR: s.behaviour = static_cast<Behaviour>(g_value_get_enum(value)); break;
     case PROP_STATS_INTERVAL: s.stats_interval = g_value_get_uint(value); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
@@ -767,12 +753,12 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
   const Settings &s = *self->settings;
   switch (id) {
     case PROP_MODEL: g_value_set_string(value, s.model.c_str()); break;
-    case PROP_ITERS_S16: g_value_set_uint(value, s.iters_s16); break;
-    case PROP_ITERS_S8: g_value_set_uint(value, s.iters_s8); break;
-    case PROP_MODEL_WIDTH: g_value_set_uint(value, s.model_width); break;
-    case PROP_MODEL_HEIGHT: g_value_set_uint(value, s.model_height); break;
-    case PROP_THREADS: g_value_set_uint(value, s.threads); break;
-    case PROP_CHANNEL_ORDER: g_value_set_enum(value, static_cast<gint>(s.order)); break;
+    case PROP_ITERS_S16: g_value_set_uint(value, static_cast<guint>(s.session.iterations.s16)); break;
+    case PROP_ITERS_S8: g_value_set_uint(value, static_cast<guint>(s.session.iterations.s8)); break;
+    case PROP_MODEL_WIDTH: g_value_set_uint(value, static_cast<guint>(s.session.model_width)); break;
+    case PROP_MODEL_HEIGHT: g_value_set_uint(value, static_cast<guint>(s.session.model_height)); break;
+    case PROP_THREADS: g_value_set_uint(value, static_cast<guint>(s.session.threads)); break;
+    case PROP_CHANNEL_ORDER: g_value_set_enum(value, static_cast<gint>(s.session.network_order)); break;
     case PROP_BEHAVIOUR: g_value_set_enum(value, static_cast<gint>(s.behaviour)); break;
     case PROP_STATS_INTERVAL: g_value_set_uint(value, s.stats_interval); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
@@ -814,30 +800,30 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
                           nullptr, rw_null));
   g_object_class_install_property(
       gobject_class, PROP_ITERS_S16,
-      g_param_spec_uint("iters-s16", "Iterations at 1/16", "Refinement iterations at 1/16 resolution", 0, 32,
-                        DEFAULT_ITERS_S16, rw));
+      g_param_spec_uint("iters-s16", "Iterations at 1/16", "Refinement iterations at 1/16 resolution", 0,
+                        SessionLimits::max_iterations_s16, DEFAULT_SESSION.iterations.s16, rw));
   g_object_class_install_property(
       gobject_class, PROP_ITERS_S8,
-      g_param_spec_uint("iters-s8", "Iterations at 1/8", "Refinement iterations at 1/8 resolution", 0, 64,
-                        DEFAULT_ITERS_S8, rw));
+      g_param_spec_uint("iters-s8", "Iterations at 1/8", "Refinement iterations at 1/8 resolution", 0,
+                        SessionLimits::max_iterations_s8, DEFAULT_SESSION.iterations.s8, rw));
   g_object_class_install_property(
       gobject_class, PROP_MODEL_WIDTH,
       g_param_spec_uint("model-width", "Model width",
-                        "Width the network runs at (multiple of 16); 0: the frame's own size, edge-padded", 0, 16384,
-                        DEFAULT_MODEL_SIZE, rw));
+                        "Width the network runs at (multiple of 16); 0: the frame's own size, edge-padded", 0,
+                        SessionLimits::max_side, DEFAULT_SESSION.model_width, rw));
   g_object_class_install_property(
       gobject_class, PROP_MODEL_HEIGHT,
       g_param_spec_uint("model-height", "Model height",
                         "Height the network runs at (multiple of 16); 0: the frame's own size, edge-padded", 0,
-                        16384, DEFAULT_MODEL_SIZE, rw));
+                        SessionLimits::max_side, DEFAULT_SESSION.model_height, rw));
   g_object_class_install_property(
       gobject_class, PROP_THREADS,
-      g_param_spec_uint("threads", "Threads", "CPU threads for inference (0: all cores)", 0, 1024, DEFAULT_THREADS,
-                        rw));
+      g_param_spec_uint("threads", "Threads", "CPU threads for inference (0: all cores)", 0,
+                        SessionLimits::max_threads, DEFAULT_SESSION.threads, rw));
   g_object_class_install_property(
       gobject_class, PROP_CHANNEL_ORDER,
       g_param_spec_enum("channel-order", "Channel order", "Colour order fed to the network", channel_order_get_type(),
-                        static_cast<gint>(ChannelOrder::rgb), rw));
+                        static_cast<gint>(DEFAULT_SESSION.network_order), rw));
   g_object_class_install_property(
       gobject_class, PROP_BEHAVIOUR,
       g_param_spec_enum("behaviour", "Behaviour",

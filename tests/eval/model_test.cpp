@@ -60,8 +60,8 @@ class EvalModel : public ::testing::Test {
     if (!dir || !fs::exists(*dir / "neuflow-v2-seed0/checkpoint.pth")) return;
     model_ = model::FlowModel::load(*dir / "neuflow-v2-seed0/checkpoint.pth");
   }
-  ModelPredictorOptions tiny() const {
-    ModelPredictorOptions o;
+  model::SessionOptions tiny() const {
+    model::SessionOptions o;
     o.iterations = {1, 1};
     o.threads = 1;  // one thread: bit-identical runs, and kind to a shared machine
     return o;
@@ -124,8 +124,8 @@ TEST_F(EvalModel, ChannelOrderChangesWhatTheNetworkSees) {
   NEUFLOW_REQUIRE_FIXTURE(frame0, "neuflow-v2-seed0/frame0.png");
   const cv::Mat a = read_bgr_image(frame0)(cv::Rect(0, 0, 64, 48)).clone();
   const cv::Mat b = read_bgr_image(frame0.parent_path() / "frame1.png")(cv::Rect(0, 0, 64, 48)).clone();
-  ModelPredictorOptions bgr = tiny();
-  bgr.feed_bgr = true;
+  model::SessionOptions bgr = tiny();
+  bgr.network_order = model::ChannelOrder::bgr;
   ModelPredictor as_rgb(model_, tiny()), as_bgr(model_, bgr);
   // Feeding BGR is the same as feeding RGB images whose channels were swapped.
   cv::Mat a_swapped, b_swapped;

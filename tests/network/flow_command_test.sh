@@ -45,4 +45,30 @@ PY
 [ $? -ne 0 ] || fail "an unknown output extension must fail"
 "$neuflow" flow -m "$fixture/checkpoint.pth" "$fixture/frame0.png" "$fixture/frame1.png" "$out/no/such/dir/x.flo"
 [ $? -eq 73 ] || fail "an unwritable output must exit 73"
+# The model options have the element's names; --size and --bgr are the earlier spellings,
+# kept hidden: each pair must give the same flow, and the help shows only the new names.
+run_pair() {  # run_pair OUT OPTIONS...
+  local result=$1; shift
+  "$neuflow" flow --threads 2 --iters-s8 1 -m "$fixture/checkpoint.pth" "$fixture/frame0.png" "$fixture/frame1.png" \
+    "$result" "$@" || fail "neuflow flow $* exited $?"
+}
+run_pair "$out/named.npy" --model-width 160 --model-height 128 --channel-order bgr
+run_pair "$out/alias.npy" --size 160x128 --bgr
+run_pair "$out/rgb.npy" --model-width 160 --model-height 128
+"$python" - "$out/named.npy" "$out/alias.npy" "$out/rgb.npy" <<'PY' || fail "the old spellings differ from the new names"
+import sys, numpy as np
+named, alias, rgb = (np.load(p) for p in sys.argv[1:])
+assert named.shape == (256, 320, 2), named.shape
+assert np.array_equal(named, alias), "--size/--bgr must equal --model-width/--model-height/--channel-order"
+assert not np.array_equal(named, rgb), "--channel-order bgr must change what the network sees"
+PY
+"$neuflow" flow --help | grep -q -- "--model-width" || fail "help must list --model-width"
+if "$neuflow" flow --help | grep -q -- "--size"; then fail "help must not list the hidden --size"; fi
+"$neuflow" flow -m "$fixture/checkpoint.pth" --model-width 100 --model-height 64 \
+  "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo" 2>"$out/err"
+[ $? -eq 1 ] || fail "a model width that is not a multiple of 16 must fail"
+grep -q "model-width: expected a multiple of 16" "$out/err" || fail "unclear model-width error: $(cat "$out/err")"
+"$neuflow" flow -m "$fixture/checkpoint.pth" --size 160 "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo" \
+  2>"$out/err"
+[ $? -eq 1 ] && grep -q "WIDTHxHEIGHT" "$out/err" || fail "--size without a height must say WIDTHxHEIGHT"
 echo "all flow command checks passed"

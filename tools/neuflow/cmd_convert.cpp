@@ -13,6 +13,7 @@
 #include "convert_inputs.hpp"
 #include "convert_job.hpp"
 #include "convert_progress.hpp"
+#include "session_options.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -26,11 +27,8 @@ struct ConvertArgs {
   std::vector<std::string> inputs;
   std::vector<std::pair<std::string, std::string>> pairs;
   std::string output;
-  int model_width = 0, model_height = 0;
-  int iters_s16 = 1, iters_s8 = 8;
-  int threads = 0;
+  SessionArgs session;
   // Words, mapped after parsing (CLI11 2.1 cannot print FlowFormat's default).
-  std::string channel_order = "rgb";
   std::string format = "flo";
   std::string viz = "none";
   double max_flow = 20;
@@ -70,15 +68,7 @@ std::string summary_line(const InputSpec& input, const InputOutcome& outcome) {
 }
 
 void run_convert(const ConvertArgs& a) {
-  if ((a.model_width == 0) != (a.model_height == 0)) {
-    throw CommandError(kExitFailure, "--model-width and --model-height go together (both 0: the frames' own size)");
-  }
-  for (const int side : {a.model_width, a.model_height}) {
-    if (side != 0 && (side % 16 != 0 || side < 32)) {
-      throw CommandError(kExitFailure, "--model-width/--model-height must be multiples of 16, at least 32; got " +
-                                           std::to_string(side));
-    }
-  }
+  const model::SessionOptions options = session_options(a.session);
   if (a.inputs.empty() && a.pairs.empty()) throw CommandError(kExitFailure, "nothing to convert: give INPUT... or --pair A B");
 
   std::shared_ptr<const model::FlowModel> model;
@@ -87,11 +77,6 @@ void run_convert(const ConvertArgs& a) {
   } catch (const model::CheckpointError& e) {
     throw CommandError(exit_code_for(e), e.what());
   }
-  model::SessionOptions options;
-  options.iterations = {a.iters_s16, a.iters_s8};
-  options.model_width = a.model_width;
-  options.model_height = a.model_height;
-  options.threads = a.threads;
   model::FlowSession session(model, options);
 
   ConvertSettings settings;
@@ -103,7 +88,6 @@ void run_convert(const ConvertArgs& a) {
   settings.max_flow = a.max_flow;
   settings.resume = a.resume;
   settings.max_frames = a.max_frames;
-  settings.network_order = a.channel_order == "bgr" ? model::ChannelOrder::bgr : model::ChannelOrder::rgb;
 
   const int fd = ::fileno(stderr);
   const bool terminal = ::isatty(fd) != 0;
@@ -171,28 +155,7 @@ void register_convert(CLI::App& app) {
                        : "--max-frames wants 0 (all frames) or a number of frames, got '" + value + "'";
           },
           "N"));
-  sub->add_option("--model-width", args->model_width,
-                  "Width the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 16384));
-  sub->add_option("--model-height", args->model_height,
-                  "Height the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 16384));
-  sub->add_option("--iters-s16", args->iters_s16, "Refinement iterations at 1/16 resolution")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 32));
-  sub->add_option("--iters-s8", args->iters_s8, "Refinement iterations at 1/8 resolution")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 64));
-  sub->add_option("--channel-order", args->channel_order,
-                  "Colour order fed to the network: rgb (what the published weights were trained with) or bgr (as "
-                  "the reference demo scripts feed it)")
-      ->check(CLI::IsMember({"rgb", "bgr"}))
-      ->capture_default_str();
-  sub->add_option("--threads", args->threads, "CPU threads for inference (0: all cores)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 1024));
+  add_session_options(*sub, args->session);
   sub->add_option("INPUT", args->inputs,
                   "Folders of frames, video files or URIs, or two image files (a pair); several at once");
   sub->callback([args] { run_convert(*args); });

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "session_options.hpp"
 #include "neuflow/eval/errors.hpp"
 #include "neuflow/eval/evaluate.hpp"
 #include "neuflow/eval/layouts.hpp"
@@ -28,12 +29,9 @@ namespace {
 struct EvalArgs {
   std::string dataset, root, model, predictions, json;
   std::string pass = "both";
-  std::string channel_order = "rgb";
   bool per_sequence = false;
   std::size_t max_pairs = 0;
-  int iters_s16 = 1;
-  int iters_s8 = 8;
-  int threads = 0;
+  SessionArgs session;
 };
 
 constexpr const char* kFooter =
@@ -90,10 +88,7 @@ eval::FlowSource make_source(const EvalArgs& a) {
   } catch (const model::CheckpointError& e) {
     throw CommandError(exit_code_for(e), std::string("eval: ") + e.what());
   }
-  eval::ModelPredictorOptions options;
-  options.iterations = {a.iters_s16, a.iters_s8};
-  options.threads = a.threads;
-  options.feed_bgr = a.channel_order == "bgr";
+  const model::SessionOptions options = session_options(a.session);
   // FlowSource is copyable and FlowSession is not: share one predictor.
   auto predictor = std::make_shared<eval::ModelPredictor>(std::move(model), options);
   return [predictor](const eval::EvalSet& set, const eval::Pair& pair) { return (*predictor)(set, pair); };
@@ -148,8 +143,9 @@ void run(const EvalArgs& a) {
     run.root = std::filesystem::absolute(a.root);
     if (!a.model.empty()) run.model = std::filesystem::absolute(a.model);
     if (!a.predictions.empty()) run.predictions = std::filesystem::absolute(a.predictions);
-    run.iterations = {a.iters_s16, a.iters_s8};
-    run.feed_bgr = a.channel_order == "bgr";
+    const model::SessionOptions session = session_options(a.session);
+    run.iterations = session.iterations;
+    run.network_order = session.network_order;
     run.max_pairs = a.max_pairs;
     write_json(a.json, eval::format_json(run, results, a.per_sequence));
   }
@@ -187,23 +183,11 @@ void register_eval(CLI::App& app) {
   cmd->add_flag("--per-sequence", a->per_sequence, "Break the results down by sequence");
   cmd->add_option("--max-pairs", a->max_pairs, "Score only the first N pairs of each set (default: all)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--iters-s16", a->iters_s16, "Refinement iterations at 1/16 resolution")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 32))
-      ->needs(model);
-  cmd->add_option("--iters-s8", a->iters_s8, "Refinement iterations at 1/8 resolution")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 64))
-      ->needs(model);
-  cmd->add_option("--threads", a->threads, "CPU threads (0: all cores)")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber)
-      ->needs(model);
-  cmd->add_option("--channel-order", a->channel_order,
-                  "Channel order fed to the network: rgb as it was trained, bgr as the reference demo scripts")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"rgb", "bgr"}))
-      ->needs(model);
+  // The reference evaluation pads each pair itself, so no model size is offered here.
+  add_session_options(*cmd, a->session, ModelSizeOptions::not_offered);
+  for (const char* name : {"--iters-s16", "--iters-s8", "--threads", "--channel-order", "--bgr"}) {
+    cmd->get_option(name)->needs(model);
+  }
   cmd->callback([a] { run_mapping_errors(*a); });
 }
 

@@ -35,15 +35,9 @@ const char* extension_of(flow::FlowFormat format) {
   return ".flo";
 }
 
-model::ImageView view_of(const Frame& frame, model::ChannelOrder network_order) {
-  // ImageView::order tells the session how to read the bytes; feeding the network BGR means
-  // describing the data as the opposite of what it holds.
-  model::ChannelOrder order = frame.data_order;
-  if (network_order == model::ChannelOrder::bgr) {
-    order = order == model::ChannelOrder::rgb ? model::ChannelOrder::bgr : model::ChannelOrder::rgb;
-  }
+model::ImageView view_of(const Frame& frame) {
   return {frame.pixels.data, frame.pixels.cols, frame.pixels.rows, static_cast<std::ptrdiff_t>(frame.pixels.step[0]),
-          order};
+          frame.data_order};
 }
 
 std::string describe(const Frame& frame) {
@@ -181,9 +175,9 @@ flow::FlowField Conversion::compute(const Frame& from, const Frame& to) {
     // stream again from it, so the result is the same as in an uninterrupted run.
     if (!session_holds_from_) {
       session_.reset();
-      session_.push(view_of(from, settings_.network_order));
+      session_.push(view_of(from));
     }
-    auto field = session_.push(view_of(to, settings_.network_order));
+    auto field = session_.push(view_of(to));
     session_holds_from_ = true;
     if (!field) throw std::logic_error("the session returned no flow for a pair");
     return std::move(*field);

@@ -31,7 +31,6 @@ struct ConvertSettings {
   double max_flow = 20;  // px at full saturation, fixed so colours mean the same in every frame
   bool resume = false;   // keep flow files that exist and read back at the right size
   std::int64_t max_frames = 0;  // 0: every frame; else only the first max_frames of each input
-  model::ChannelOrder network_order = model::ChannelOrder::rgb;  // what the network is fed
 };
 
 struct InputOutcome {

@@ -13,10 +13,7 @@ namespace neuflow::eval {
 
 namespace {
 
-model::SessionOptions session_options(const ModelPredictorOptions& options) {
-  model::SessionOptions s;
-  s.iterations = options.iterations;
-  s.threads = options.threads;
+model::SessionOptions session_options(model::SessionOptions s) {
   // 0 × 0: the session runs at the input's own size; we hand it sizes that are already
   // multiples of 16, so its own (always centred) padding stays zero.
   s.model_width = s.model_height = 0;
@@ -40,8 +37,8 @@ cv::Mat read_bgr_image(const std::filesystem::path& path) {
   return image;
 }
 
-ModelPredictor::ModelPredictor(std::shared_ptr<const model::FlowModel> model, const ModelPredictorOptions& options)
-    : feed_bgr_(options.feed_bgr), session_(std::move(model), session_options(options)) {}
+ModelPredictor::ModelPredictor(std::shared_ptr<const model::FlowModel> model, const model::SessionOptions& options)
+    : session_(std::move(model), session_options(options)) {}
 
 flow::FlowField ModelPredictor::predict(const cv::Mat& bgr0, const cv::Mat& bgr1, PadMode mode) {
   if (bgr0.size() != bgr1.size() || bgr0.type() != CV_8UC3 || bgr1.type() != CV_8UC3) {
@@ -50,11 +47,8 @@ flow::FlowField ModelPredictor::predict(const cv::Mat& bgr0, const cv::Mat& bgr1
   }
   const Padding padding = reference_padding(bgr0.cols, bgr0.rows, mode);
   const cv::Mat padded0 = pad_image(bgr0, padding), padded1 = pad_image(bgr1, padding);
-  // The view's order is the data's order, which the session converts to RGB; declaring BGR
-  // data as RGB is how the network gets fed BGR.
-  const auto order = feed_bgr_ ? model::ChannelOrder::rgb : model::ChannelOrder::bgr;
-  const auto view = [order](const cv::Mat& m) {
-    return model::ImageView{m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), order};
+  const auto view = [](const cv::Mat& m) {
+    return model::ImageView{m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), model::ChannelOrder::bgr};
   };
   try {
     return crop_flow(session_.compute(view(padded0), view(padded1)), padding);

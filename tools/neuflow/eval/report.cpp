@@ -106,7 +106,7 @@ std::string format_json(const RunDescription& run, const std::vector<SetResult>&
   } else {
     out += ", \"source\": \"model\", \"model\": " + json_string(run.model.string()) +
            ", \"iters_s16\": " + std::to_string(run.iterations.s16) + ", \"iters_s8\": " +
-           std::to_string(run.iterations.s8) + ", \"channel_order\": " + (run.feed_bgr ? "\"bgr\"" : "\"rgb\"");
+           std::to_string(run.iterations.s8) + ", \"channel_order\": \"" + std::string(model::channel_order_name(run.network_order)) + "\"";
   }
   out += ", \"max_pairs\": " + (run.max_pairs == 0 ? std::string("null") : std::to_string(run.max_pairs));
   out += ",\n \"results\": [";

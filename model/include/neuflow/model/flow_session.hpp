@@ -9,34 +9,19 @@
 
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
 
 namespace neuflow::model {
 
-enum class ChannelOrder { rgb, bgr };
-
-// An 8-bit, 3-channel interleaved image; `stride` is the number of bytes between rows.
+// An 8-bit, 3-channel interleaved image; `stride` is the number of bytes between rows and
+// `order` the order its pixels hold (the session feeds the network SessionOptions::network_order).
 struct ImageView {
   const std::uint8_t* data = nullptr;
   int width = 0;
   int height = 0;
   std::ptrdiff_t stride = 0;
-  ChannelOrder order = ChannelOrder::rgb;  // the networks were trained on RGB
-};
-
-struct Iterations {
-  int s16 = 1;  // refinement iterations at 1/16
-  int s8 = 8;   // refinement iterations at 1/8
-};
-
-struct SessionOptions {
-  Iterations iterations;
-  // 0 × 0: run at the input's own size, edge-padded to multiples of 16 and cropped back.
-  // Otherwise resize the input to this size (multiples of 16, at least 32) and the flow back,
-  // rescaling its vectors to input pixels.
-  int model_width = 0;
-  int model_height = 0;
-  int threads = 0;  // 0: OpenMP's default (all cores)
+  ChannelOrder order = ChannelOrder::rgb;
 };
 
 class FlowSession {
@@ -46,6 +31,7 @@ class FlowSession {
   FlowSession(const FlowSession&) = delete;
   FlowSession& operator=(const FlowSession&) = delete;
 
+  // Throws std::invalid_argument with check_session_options()'s message for unusable options.
   // Flow from frame0 to frame1 at frame0's size (both must have the same size). Does not
   // touch the stream state. Throws std::invalid_argument for unusable images.
   flow::FlowField compute(const ImageView& frame0, const ImageView& frame1);

@@ -19,15 +19,10 @@ namespace neuflow::eval {
 // when the file is absent, malformed_input when OpenCV cannot decode it.
 cv::Mat read_bgr_image(const std::filesystem::path& path);
 
-struct ModelPredictorOptions {
-  model::Iterations iterations;
-  int threads = 0;         // 0: all cores
-  bool feed_bgr = false;   // feed the network BGR (as the reference demo scripts) instead of RGB (as trained)
-};
-
 class ModelPredictor {
  public:
-  ModelPredictor(std::shared_ptr<const model::FlowModel> model, const ModelPredictorOptions& options);
+  // The options' model size is ignored: the pairs are padded here as the reference pads them.
+  ModelPredictor(std::shared_ptr<const model::FlowModel> model, const model::SessionOptions& options);
 
   // Flow from image0 to image1 (8-bit BGR, same size) at their size. Throws EvalError
   // (malformed_input) when the sizes differ or the network cannot take them.
@@ -37,7 +32,6 @@ class ModelPredictor {
   flow::FlowField operator()(const EvalSet& set, const Pair& pair);
 
  private:
-  bool feed_bgr_;
   model::FlowSession session_;
 };
 

@@ -18,7 +18,7 @@ struct RunDescription {
   std::filesystem::path model;        // the checkpoint, or empty when scoring predictions
   std::filesystem::path predictions;  // the predictions folder, or empty when running a model
   model::Iterations iterations;
-  bool feed_bgr = false;
+  model::ChannelOrder network_order = model::ChannelOrder::rgb;
   std::size_t max_pairs = 0;  // 0: all pairs
 };
 

@@ -1,0 +1,68 @@
+#pragma once
+// What a flow session can be asked to do, with its defaults and limits, in one place. The
+// session checks its options here; the GStreamer element's property ranges, the daemon's
+// config checks and the CLI's options take their limits and messages from here too, so a
+// setting changes in one file. Nothing here needs the network, so the daemon links it alone.
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace neuflow::model {
+
+enum class ChannelOrder { rgb, bgr };
+
+struct Iterations {
+  int s16 = 1;  // refinement iterations at 1/16
+  int s8 = 8;   // refinement iterations at 1/8
+  bool operator==(const Iterations&) const = default;
+};
+
+struct SessionLimits {
+  static constexpr int max_iterations_s16 = 32;
+  static constexpr int max_iterations_s8 = 64;
+  // The network works on multiples of 16 (its 1/16 feature map); below 32 nothing is left.
+  static constexpr int model_side_multiple = 16;
+  static constexpr int min_side = 32;
+  static constexpr int max_side = 16384;  // frames and model sizes alike
+  static constexpr int max_threads = 1024;
+};
+
+struct SessionOptions {
+  Iterations iterations;
+  // 0 × 0: run at the input's own size, edge-padded to multiples of 16 and cropped back.
+  // Otherwise resize the input to this size (multiples of 16, at least 32) and the flow back,
+  // rescaling its vectors to input pixels.
+  int model_width = 0;
+  int model_height = 0;
+  int threads = 0;  // 0: OpenMP's default (all cores)
+  // The order the network is fed, whatever order the images hold: RGB as the published
+  // weights were trained, BGR as the reference demo scripts (which read with OpenCV) feed it.
+  ChannelOrder network_order = ChannelOrder::rgb;
+  bool operator==(const SessionOptions&) const = default;
+};
+
+// Each check returns what is wrong, worded to follow a setting's name ("expected …, got …"),
+// or nothing when the value is usable.
+std::optional<std::string> check_iterations_s16(int value);
+std::optional<std::string> check_iterations_s8(int value);
+std::optional<std::string> check_model_side(int value);   // one of model width/height; 0 allowed
+std::optional<std::string> check_threads(int value);
+// Both sides: each usable, and both 0 or both set.
+std::optional<std::string> check_model_size(int width, int height);
+// The whole set, each problem prefixed with the setting's name ("iters-s8: expected …").
+std::optional<std::string> check_session_options(const SessionOptions& options);
+
+struct ModelSize {
+  int width = 0;
+  int height = 0;
+  bool operator==(const ModelSize&) const = default;
+};
+
+// The size the network runs at for frames of this size: the options' model size when set,
+// else the frame's own size rounded up to multiples of 16.
+ModelSize model_size_for(int frame_width, int frame_height, const SessionOptions& options);
+
+constexpr std::string_view channel_order_name(ChannelOrder order) { return order == ChannelOrder::bgr ? "bgr" : "rgb"; }
+std::optional<ChannelOrder> parse_channel_order(std::string_view name);
+
+}  // namespace neuflow::model

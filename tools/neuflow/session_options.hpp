@@ -1,0 +1,31 @@
+#pragma once
+// The model options every subcommand that runs the network takes, under the names the
+// element and the daemon's config use (--model-width, --model-height, --iters-s16,
+// --iters-s8, --threads, --channel-order), with defaults and limits from
+// neuflow/model/session_settings.hpp. `flow`'s earlier --size WxH and --bgr are kept as
+// hidden aliases for one release.
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "neuflow/model/session_settings.hpp"
+
+namespace neuflow::cli {
+
+struct SessionArgs {
+  model::SessionOptions options;
+  std::string channel_order{model::channel_order_name(model::SessionOptions{}.network_order)};
+  std::string size_alias;  // --size WxH
+  bool bgr_alias = false;  // --bgr
+};
+
+enum class ModelSizeOptions { offered, not_offered };
+
+// Registers the options on `command`; `args` must outlive the parse.
+void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions model_size = ModelSizeOptions::offered);
+
+// The parsed options, checked as the session checks them. Throws CommandError (kExitFailure)
+// naming the option and what it expected.
+model::SessionOptions session_options(const SessionArgs& args);
+
+}  // namespace neuflow::cli
