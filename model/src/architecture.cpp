@@ -1,5 +1,6 @@
 #include "neuflow/model/architecture.hpp"
 
+#include <stdexcept>
 #include <unordered_set>
 
 namespace neuflow::model {
@@ -8,96 +9,134 @@ namespace {
 
 using Shape = std::vector<int64_t>;
 
-class TableBuilder {
+class LayerTable {
  public:
-  void add(std::string name, Shape shape, ParameterKind kind = ParameterKind::kParameter) {
-    table_.push_back({std::move(name), std::move(shape), kind});
+  explicit LayerTable(std::vector<LayerSpec>& layers) : layers_(layers) {}
+
+  void conv(std::string name, int in, int out, int kernel, bool bias, Stage stage, int scale, int runs = 1) {
+    layers_.push_back({std::move(name), LayerKind::conv, out, in, kernel, bias, stage, scale, runs});
   }
-  // BatchNorm2d(channels): affine parameters, running statistics, batch counter.
-  void batch_norm(const std::string& prefix, int64_t channels) {
-    add(prefix + ".weight", {channels});
-    add(prefix + ".bias", {channels});
-    add(prefix + ".running_mean", {channels}, ParameterKind::kRunningStat);
-    add(prefix + ".running_var", {channels}, ParameterKind::kRunningStat);
-    add(prefix + ".num_batches_tracked", {}, ParameterKind::kBatchCounter);
+  void linear(std::string name, int in, int out, bool bias, int runs) {
+    layers_.push_back({std::move(name), LayerKind::linear, out, in, 0, bias, Stage::cross_attention, 16, runs});
   }
-  // ConvBlock(cin -> cout, k): conv1 (k x k, no bias), conv2 (3x3, no bias), norm1, norm2.
-  void conv_block(const std::string& prefix, int64_t cin, int64_t cout, int64_t k) {
-    add(prefix + ".conv1.weight", {cout, cin, k, k});
-    add(prefix + ".conv2.weight", {cout, cout, 3, 3});
-    batch_norm(prefix + ".norm1", cout);
-    batch_norm(prefix + ".norm2", cout);
+  void batch_norm(std::string name, int channels, Stage stage) {
+    layers_.push_back({std::move(name), LayerKind::batch_norm, channels, channels, 0, true, stage, 8, 0});
   }
-  // One cross-attention layer over 192-dim tokens.
-  void attention_layer(const std::string& prefix, int64_t dim) {
-    for (const char* proj : {"q_proj", "k_proj", "v_proj", "merge"}) {
-      add(prefix + "." + proj + ".weight", {dim, dim});
-      add(prefix + "." + proj + ".bias", {dim});
+  void layer_norm(std::string name, int channels) {
+    layers_.push_back({std::move(name), LayerKind::layer_norm, channels, channels, 0, true, Stage::cross_attention,
+                       16, 0});
+  }
+  // ConvBlock(in -> out, k): conv1 (k x k, no bias), conv2 (3x3, no bias), norm1, norm2.
+  void conv_block(const std::string& prefix, int in, int out, int k, Stage stage, int scale) {
+    conv(prefix + ".conv1", in, out, k, false, stage, scale);
+    conv(prefix + ".conv2", out, out, 3, false, stage, scale);
+    batch_norm(prefix + ".norm1", out, stage);
+    batch_norm(prefix + ".norm2", out, stage);
+  }
+  // One cross-attention layer over `dim`-wide tokens, run for both frames.
+  void attention_layer(const std::string& prefix, int dim) {
+    for (const char* projection : {"q_proj", "k_proj", "v_proj", "merge"}) {
+      linear(prefix + "." + projection, dim, dim, true, 2);
     }
-    add(prefix + ".norm1.weight", {dim});
-    add(prefix + ".norm1.bias", {dim});
-    add(prefix + ".mlp.0.weight", {2 * dim, 2 * dim});
-    add(prefix + ".mlp.2.weight", {dim, 2 * dim});
-    add(prefix + ".norm2.weight", {dim});
-    add(prefix + ".norm2.bias", {dim});
+    layer_norm(prefix + ".norm1", dim);
+    linear(prefix + ".mlp.0", 2 * dim, 2 * dim, false, 2);
+    linear(prefix + ".mlp.2", 2 * dim, dim, false, 2);
+    layer_norm(prefix + ".norm2", dim);
   }
   // conv3x3 -> GELU -> conv3x3 -> BN, as a Sequential (.0, .2, .3).
-  void merge(const std::string& prefix, int64_t cin, int64_t cout) {
-    add(prefix + ".0.weight", {cout, cin, 3, 3});
-    add(prefix + ".2.weight", {cout, cout, 3, 3});
-    batch_norm(prefix + ".3", cout);
+  void merge(const std::string& prefix, int in, int out, int runs) {
+    conv(prefix + ".0", in, out, 3, false, Stage::merge_s8, 8, runs);
+    conv(prefix + ".2", out, out, 3, false, Stage::merge_s8, 8, runs);
+    batch_norm(prefix + ".3", out, Stage::merge_s8);
   }
-  // Refinement block: 212 input channels, 66 outputs (2 flow + 64 hidden).
-  void refine(const std::string& prefix, int64_t inter) {
-    add(prefix + ".conv1.conv.weight", {128, 212, 3, 3});
-    add(prefix + ".conv2.conv.weight", {inter, 128, 3, 3});
+  // Refinement block: 212 input channels, 66 outputs (2 flow + 64 hidden), run per iteration.
+  void refine(const std::string& prefix, int inter, Stage stage, int scale) {
+    conv(prefix + ".conv1.conv", 212, 128, 3, false, stage, scale);
+    conv(prefix + ".conv2.conv", 128, inter, 3, false, stage, scale);
     for (int i = 0; i < 5; ++i) {
-      add(prefix + ".conv_layers." + std::to_string(i) + ".conv.weight", {inter, inter, 3, 3});
+      conv(prefix + ".conv_layers." + std::to_string(i) + ".conv", inter, inter, 3, false, stage, scale);
     }
-    add(prefix + ".conv3.weight", {66, inter, 3, 3});
-    add(prefix + ".conv3.bias", {66});
+    conv(prefix + ".conv3", inter, 66, 3, true, stage, scale);
   }
-  std::vector<ParameterSpec> take() { return std::move(table_); }
 
  private:
-  std::vector<ParameterSpec> table_;
+  std::vector<LayerSpec>& layers_;
 };
 
-std::vector<ParameterSpec> build_table() {
-  TableBuilder t;
-  t.conv_block("backbone.block_8_1", 3, 256, 8);
-  t.conv_block("backbone.block_8_2", 3, 128, 6);
-  t.conv_block("backbone.block_cat_8", 384, 192, 3);
-  t.conv_block("backbone.block_16_1", 3, 128, 6);
-  t.conv_block("backbone.block_8_16", 192, 128, 6);
-  t.conv_block("backbone.block_cat_16", 256, 190, 3);
+std::vector<LayerSpec> build_layers() {
+  std::vector<LayerSpec> layers;
+  LayerTable t(layers);
+  constexpr Stage B = Stage::backbone;
+  t.conv_block("backbone.block_8_1", 3, 256, 8, B, 8);
+  t.conv_block("backbone.block_8_2", 3, 128, 6, B, 8);
+  t.conv_block("backbone.block_cat_8", 384, 192, 3, B, 8);
+  t.conv_block("backbone.block_16_1", 3, 128, 6, B, 16);
+  t.conv_block("backbone.block_8_16", 192, 128, 6, B, 16);
+  t.conv_block("backbone.block_cat_16", 256, 190, 3, B, 16);
   t.attention_layer("cross_attn_s16.layers.0", 192);
   t.attention_layer("cross_attn_s16.layers.1", 192);
-  t.batch_norm("cross_attn_s16.norm", 192);
-  t.merge("merge_s8", 256, 128);
-  t.merge("context_merge_s8", 128, 64);
-  t.refine("refine_s16", 128);
-  t.refine("refine_s8", 96);
-  t.conv_block("conv_s8", 3, 128, 8);
-  t.add("upsample_s8.conv1.weight", {256, 130, 3, 3});
-  t.add("upsample_s8.conv1.bias", {256});
-  t.add("upsample_s8.conv2.weight", {512, 256, 3, 3});
-  t.add("upsample_s8.conv2.bias", {512});
-  t.add("upsample_s8.conv3.weight", {576, 512, 1, 1});
-  t.add("upsample_s8.conv3.bias", {576});
-  return t.take();
+  t.batch_norm("cross_attn_s16.norm", 192, Stage::cross_attention);
+  t.merge("merge_s8", 256, 128, 2);  // both frames' features
+  t.merge("context_merge_s8", 128, 64, 1);
+  t.refine("refine_s16", 128, Stage::refine_s16, 16);
+  t.refine("refine_s8", 96, Stage::refine_s8, 8);
+  t.conv_block("conv_s8", 3, 128, 8, Stage::upsample_features, 8);
+  t.conv("upsample_s8.conv1", 130, 256, 3, true, Stage::upsampler, 8);
+  t.conv("upsample_s8.conv2", 256, 512, 3, true, Stage::upsampler, 8);
+  t.conv("upsample_s8.conv3", 512, 576, 1, true, Stage::upsampler, 8);
+  return layers;
 }
 
-std::string shape_text(const std::vector<int64_t>& shape) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
-  return s + "]";
+// A layer's tensors as torch.save writes them.
+void add_tensors(const LayerSpec& layer, std::vector<ParameterSpec>& table) {
+  const auto add = [&](const char* suffix, Shape shape, ParameterKind kind = ParameterKind::kParameter) {
+    table.push_back({layer.name + suffix, std::move(shape), kind});
+  };
+  switch (layer.kind) {
+    case LayerKind::conv:
+      add(".weight", {layer.out, layer.in, layer.kernel, layer.kernel});
+      if (layer.bias) add(".bias", {layer.out});
+      break;
+    case LayerKind::linear:
+      add(".weight", {layer.out, layer.in});
+      if (layer.bias) add(".bias", {layer.out});
+      break;
+    case LayerKind::layer_norm:
+      add(".weight", {layer.out});
+      add(".bias", {layer.out});
+      break;
+    case LayerKind::batch_norm:
+      add(".weight", {layer.out});
+      add(".bias", {layer.out});
+      add(".running_mean", {layer.out}, ParameterKind::kRunningStat);
+      add(".running_var", {layer.out}, ParameterKind::kRunningStat);
+      add(".num_batches_tracked", {}, ParameterKind::kBatchCounter);
+      break;
+  }
+}
+
+std::vector<ParameterSpec> build_parameters() {
+  std::vector<ParameterSpec> table;
+  for (const auto& layer : neuflow_v2_layers()) add_tensors(layer, table);
+  return table;
 }
 
 }  // namespace
 
+const std::vector<LayerSpec>& neuflow_v2_layers() {
+  static const std::vector<LayerSpec> layers = build_layers();
+  return layers;
+}
+
+const LayerSpec& neuflow_v2_layer(std::string_view name) {
+  for (const auto& layer : neuflow_v2_layers()) {
+    if (layer.name == name) return layer;
+  }
+  throw std::out_of_range("NeuFlow-V2 has no layer '" + std::string(name) + "'");
+}
+
 const std::vector<ParameterSpec>& neuflow_v2_parameters() {
-  static const std::vector<ParameterSpec> table = build_table();
+  static const std::vector<ParameterSpec> table = build_parameters();
   return table;
 }
 

@@ -9,7 +9,7 @@ namespace neuflow::model {
 namespace {
 
 constexpr int kContext = kContextChannels;  // channels 0..63 are context, 64.. are features
-constexpr int kFeatures = 128;
+constexpr int kFeatures = kMatchingChannels;
 
 void observe(const StageObserver* observer, const std::string& name, int frame, const Tensor& t) {
   if (observer && *observer) (*observer)(StageTensor{name, frame, t.h, t.w, t.c, t.data.data()});

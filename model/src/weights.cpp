@@ -1,19 +1,16 @@
 #include "weights.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
+
+#include "neuflow/model/architecture.hpp"
 
 namespace neuflow::model {
 
 namespace {
 
 constexpr double kBatchNormEps = 1e-5;
-
-std::string shape_string(const std::vector<int64_t>& shape) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
-  return s + "]";
-}
 
 class WeightReader {
  public:
@@ -26,24 +23,32 @@ class WeightReader {
     }
     if (it->second.shape != shape) {
       throw CheckpointError(CheckpointError::Kind::kFormat, ckpt_.path + ": tensor '" + name + "' has shape " +
-                            shape_string(it->second.shape) + ", expected " + shape_string(shape));
+                            shape_text(it->second.shape) + ", expected " + shape_text(shape));
     }
     return it->second.data;
   }
 
-  ConvWeights conv(const std::string& prefix, int out, int in, int k, bool bias) const {
+  // Shapes come from the architecture table; a layer missing from it is a bug here.
+  static const LayerSpec& layer(const std::string& name, LayerKind kind) {
+    const LayerSpec& spec = neuflow_v2_layer(name);
+    if (spec.kind != kind) throw std::logic_error(name + " is not the kind of layer the loader reads it as");
+    return spec;
+  }
+
+  ConvWeights conv(const std::string& name) const {
+    const LayerSpec& spec = layer(name, LayerKind::conv);
     ConvWeights c;
-    c.out_channels = out;
-    c.in_channels = in;
-    c.kernel_h = c.kernel_w = k;
-    c.weight = tensor(prefix + ".weight", {out, in, k, k});
-    if (bias) c.bias = tensor(prefix + ".bias", {out});
+    c.out_channels = spec.out;
+    c.in_channels = spec.in;
+    c.kernel_h = c.kernel_w = spec.kernel;
+    c.weight = tensor(name + ".weight", {spec.out, spec.in, spec.kernel, spec.kernel});
+    if (spec.bias) c.bias = tensor(name + ".bias", {spec.out});
     return c;
   }
 
   // Per-channel affine form of an inference BatchNorm: y = x * scale + shift.
-  void batch_norm(const std::string& prefix, int channels, std::vector<float>& scale,
-                  std::vector<float>& shift) const {
+  void batch_norm(const std::string& prefix, std::vector<float>& scale, std::vector<float>& shift) const {
+    const int channels = layer(prefix, LayerKind::batch_norm).out;
     const auto& gamma = tensor(prefix + ".weight", {channels});
     const auto& beta = tensor(prefix + ".bias", {channels});
     const auto& mean = tensor(prefix + ".running_mean", {channels});
@@ -59,6 +64,9 @@ class WeightReader {
 
   // Folds a BatchNorm into the convolution before it, in double to keep rounding at one step.
   void fold_batch_norm(ConvWeights& c, const std::string& bn_prefix) const {
+    if (layer(bn_prefix, LayerKind::batch_norm).out != c.out_channels) {
+      throw std::logic_error(bn_prefix + " does not follow a convolution of its width");
+    }
     const auto& gamma = tensor(bn_prefix + ".weight", {c.out_channels});
     const auto& beta = tensor(bn_prefix + ".bias", {c.out_channels});
     const auto& mean = tensor(bn_prefix + ".running_mean", {c.out_channels});
@@ -77,58 +85,59 @@ class WeightReader {
     c.bias = std::move(bias);
   }
 
-  ConvBlockWeights conv_block(const std::string& prefix, int in, int out, int k) const {
+  ConvBlockWeights conv_block(const std::string& prefix) const {
     ConvBlockWeights b;
-    b.conv1 = conv(prefix + ".conv1", out, in, k, false);
+    b.conv1 = conv(prefix + ".conv1");
     fold_batch_norm(b.conv1, prefix + ".norm1");
-    b.conv2 = conv(prefix + ".conv2", out, out, 3, false);
+    b.conv2 = conv(prefix + ".conv2");
     fold_batch_norm(b.conv2, prefix + ".norm2");
     return b;
   }
 
-  LinearWeights linear(const std::string& prefix, int out, int in, bool bias) const {
+  LinearWeights linear(const std::string& name) const {
+    const LayerSpec& spec = layer(name, LayerKind::linear);
     LinearWeights l;
-    l.out_features = out;
-    l.in_features = in;
-    l.weight = tensor(prefix + ".weight", {out, in});
-    if (bias) l.bias = tensor(prefix + ".bias", {out});
+    l.out_features = spec.out;
+    l.in_features = spec.in;
+    l.weight = tensor(name + ".weight", {spec.out, spec.in});
+    if (spec.bias) l.bias = tensor(name + ".bias", {spec.out});
     return l;
   }
 
-  LayerNormWeights layer_norm(const std::string& prefix, int dim) const {
-    return {tensor(prefix + ".weight", {dim}), tensor(prefix + ".bias", {dim})};
+  LayerNormWeights layer_norm(const std::string& name) const {
+    const int dim = layer(name, LayerKind::layer_norm).out;
+    return {tensor(name + ".weight", {dim}), tensor(name + ".bias", {dim})};
   }
 
   AttentionLayerWeights attention_layer(const std::string& prefix) const {
-    constexpr int d = 192;
     AttentionLayerWeights a;
-    a.q_proj = linear(prefix + ".q_proj", d, d, true);
-    const float scale = static_cast<float>(1.0 / std::sqrt(static_cast<double>(d)));
+    a.q_proj = linear(prefix + ".q_proj");
+    const float scale = static_cast<float>(1.0 / std::sqrt(static_cast<double>(a.q_proj.in_features)));
     for (float& w : a.q_proj.weight) w *= scale;
     for (float& b : a.q_proj.bias) b *= scale;
-    a.k_proj = linear(prefix + ".k_proj", d, d, true);
-    a.v_proj = linear(prefix + ".v_proj", d, d, true);
-    a.merge = linear(prefix + ".merge", d, d, true);
-    a.norm1 = layer_norm(prefix + ".norm1", d);
-    a.mlp0 = linear(prefix + ".mlp.0", 2 * d, 2 * d, false);
-    a.mlp2 = linear(prefix + ".mlp.2", d, 2 * d, false);
-    a.norm2 = layer_norm(prefix + ".norm2", d);
+    a.k_proj = linear(prefix + ".k_proj");
+    a.v_proj = linear(prefix + ".v_proj");
+    a.merge = linear(prefix + ".merge");
+    a.norm1 = layer_norm(prefix + ".norm1");
+    a.mlp0 = linear(prefix + ".mlp.0");
+    a.mlp2 = linear(prefix + ".mlp.2");
+    a.norm2 = layer_norm(prefix + ".norm2");
     return a;
   }
 
-  RefineWeights refine(const std::string& prefix, int inter) const {
+  RefineWeights refine(const std::string& prefix) const {
     constexpr int in_total = kCorrChannels + kContextChannels + kHiddenChannels + 2 + 1;  // 212
     RefineWeights r;
-    r.inter_dim = inter;
-    const ConvWeights full = conv(prefix + ".conv1.conv", 128, in_total, 3, false);
+    const ConvWeights full = conv(prefix + ".conv1.conv");
+    if (full.in_channels != in_total) throw std::logic_error(prefix + ": the refinement's inputs changed");
     // Checkpoint input order: corr 0..80, context 81..144, hidden 145..208, flow 209..210, r 211.
     const auto slice = [&](const std::vector<std::pair<int, int>>& ranges) {
       ConvWeights part;
-      part.out_channels = 128;
+      part.out_channels = full.out_channels;
       part.kernel_h = part.kernel_w = 3;
       for (const auto& [begin, end] : ranges) part.in_channels += end - begin;
-      part.weight.reserve(static_cast<std::size_t>(128) * part.in_channels * 9);
-      for (int o = 0; o < 128; ++o) {
+      part.weight.reserve(static_cast<std::size_t>(full.out_channels) * part.in_channels * 9);
+      for (int o = 0; o < full.out_channels; ++o) {
         for (const auto& [begin, end] : ranges) {
           const float* src = full.weight.data() + (static_cast<std::size_t>(o) * in_total + begin) * 9;
           part.weight.insert(part.weight.end(), src, src + static_cast<std::size_t>(end - begin) * 9);
@@ -138,11 +147,10 @@ class WeightReader {
     };
     r.conv1_dynamic = slice({{0, 81}, {145, 209}, {209, 211}});
     r.conv1_constant = slice({{81, 145}, {211, 212}});
-    r.conv2 = conv(prefix + ".conv2.conv", inter, 128, 3, false);
-    for (int i = 0; i < 5; ++i) {
-      r.conv_layers[i] = conv(prefix + ".conv_layers." + std::to_string(i) + ".conv", inter, inter, 3, false);
-    }
-    r.conv3 = conv(prefix + ".conv3", 2 + kHiddenChannels, inter, 3, true);
+    r.conv2 = conv(prefix + ".conv2.conv");
+    r.inter_dim = r.conv2.out_channels;
+    for (int i = 0; i < 5; ++i) r.conv_layers[i] = conv(prefix + ".conv_layers." + std::to_string(i) + ".conv");
+    r.conv3 = conv(prefix + ".conv3");
     return r;
   }
 
@@ -155,27 +163,27 @@ class WeightReader {
 NetworkWeights build_network_weights(const Checkpoint& checkpoint) {
   const WeightReader r(checkpoint);
   NetworkWeights n;
-  n.block_8_1 = r.conv_block("backbone.block_8_1", 3, 256, 8);
-  n.block_8_2 = r.conv_block("backbone.block_8_2", 3, 128, 6);
-  n.block_cat_8 = r.conv_block("backbone.block_cat_8", 384, 192, 3);
-  n.block_16_1 = r.conv_block("backbone.block_16_1", 3, 128, 6);
-  n.block_8_16 = r.conv_block("backbone.block_8_16", 192, 128, 6);
-  n.block_cat_16 = r.conv_block("backbone.block_cat_16", 256, 190, 3);
+  n.block_8_1 = r.conv_block("backbone.block_8_1");
+  n.block_8_2 = r.conv_block("backbone.block_8_2");
+  n.block_cat_8 = r.conv_block("backbone.block_cat_8");
+  n.block_16_1 = r.conv_block("backbone.block_16_1");
+  n.block_8_16 = r.conv_block("backbone.block_8_16");
+  n.block_cat_16 = r.conv_block("backbone.block_cat_16");
   n.attention[0] = r.attention_layer("cross_attn_s16.layers.0");
   n.attention[1] = r.attention_layer("cross_attn_s16.layers.1");
-  r.batch_norm("cross_attn_s16.norm", 192, n.attention_norm_scale, n.attention_norm_shift);
-  n.merge_s8_0 = r.conv("merge_s8.0", 128, 256, 3, false);
-  n.merge_s8_2 = r.conv("merge_s8.2", 128, 128, 3, false);
+  r.batch_norm("cross_attn_s16.norm", n.attention_norm_scale, n.attention_norm_shift);
+  n.merge_s8_0 = r.conv("merge_s8.0");
+  n.merge_s8_2 = r.conv("merge_s8.2");
   r.fold_batch_norm(n.merge_s8_2, "merge_s8.3");
-  n.context_merge_s8_0 = r.conv("context_merge_s8.0", 64, 128, 3, false);
-  n.context_merge_s8_2 = r.conv("context_merge_s8.2", 64, 64, 3, false);
+  n.context_merge_s8_0 = r.conv("context_merge_s8.0");
+  n.context_merge_s8_2 = r.conv("context_merge_s8.2");
   r.fold_batch_norm(n.context_merge_s8_2, "context_merge_s8.3");
-  n.refine_s16 = r.refine("refine_s16", 128);
-  n.refine_s8 = r.refine("refine_s8", 96);
-  n.conv_s8 = r.conv_block("conv_s8", 3, 128, 8);
-  n.upsample_conv1 = r.conv("upsample_s8.conv1", 256, 130, 3, true);
-  n.upsample_conv2 = r.conv("upsample_s8.conv2", 512, 256, 3, true);
-  n.upsample_conv3 = r.conv("upsample_s8.conv3", 576, 512, 1, true);
+  n.refine_s16 = r.refine("refine_s16");
+  n.refine_s8 = r.refine("refine_s8");
+  n.conv_s8 = r.conv_block("conv_s8");
+  n.upsample_conv1 = r.conv("upsample_s8.conv1");
+  n.upsample_conv2 = r.conv("upsample_s8.conv2");
+  n.upsample_conv3 = r.conv("upsample_s8.conv3");
   return n;
 }
 

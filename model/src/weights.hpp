@@ -52,6 +52,8 @@ struct AttentionLayerWeights {
 inline constexpr int kCorrChannels = 81;
 inline constexpr int kHiddenChannels = 64;
 inline constexpr int kContextChannels = 64;
+// The attention's 192 output channels: context first, then the features that are matched.
+inline constexpr int kMatchingChannels = 128;
 inline constexpr int kRefineDynamicChannels = kCorrChannels + kHiddenChannels + 2;  // corr, hidden, flow
 inline constexpr int kRefineConstantChannels = kContextChannels + 1;                  // context, radius
 inline constexpr float kCorrRadiusPlane = 4.0f;

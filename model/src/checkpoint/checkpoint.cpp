@@ -92,11 +92,6 @@ void convert_run(const unsigned char* src, std::size_t count, StorageDtype dtype
   for (std::size_t i = 0; i < count; ++i) dst[i] = element(src + i * step, dtype, big_endian);
 }
 
-std::string shape_text(const std::vector<int64_t>& shape) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
-  return s + "]";
-}
 
 struct Storage {
   std::vector<unsigned char> bytes;
@@ -358,6 +353,12 @@ class Loader {
 };
 
 }  // namespace
+
+std::string shape_text(const std::vector<int64_t>& shape) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
+  return s + "]";
+}
 
 const CheckpointTensor* Checkpoint::find(const std::string& key) const {
   const auto it = tensors.find(key);

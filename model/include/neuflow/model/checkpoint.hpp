@@ -69,6 +69,9 @@ struct Checkpoint {
   const CheckpointTensor& at(const std::string& key) const;
 };
 
+// "[576, 512, 1, 1]", as PyTorch prints a shape; "[]" for a scalar.
+std::string shape_text(const std::vector<int64_t>& shape);
+
 // Reads a checkpoint completely (all tensors, converted to float32). Throws CheckpointError.
 Checkpoint load_checkpoint(const std::filesystem::path& path);
 
