@@ -1,10 +1,11 @@
 #pragma once
-// The GTypes of the plugin's elements, for plugin.cpp.
-#include <glib-object.h>
+// The plugin's elements, each registered by the file that defines it
+// (GST_ELEMENT_REGISTER_DEFINE), for plugin.cpp.
+#include <gst/gst.h>
 
 G_BEGIN_DECLS
-GType gst_neuflow_get_type(void);
-GType gst_neuflow_viz_get_type(void);
-GType gst_neuflow_sink_get_type(void);
-GType gst_neuflow_shm_sink_get_type(void);
+GST_ELEMENT_REGISTER_DECLARE(neuflow);
+GST_ELEMENT_REGISTER_DECLARE(neuflowviz);
+GST_ELEMENT_REGISTER_DECLARE(neuflowsink);
+GST_ELEMENT_REGISTER_DECLARE(neuflowshmsink);
 G_END_DECLS

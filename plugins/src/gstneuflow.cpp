@@ -897,3 +897,5 @@ static void gst_neuflow_init(GstNeuflow *self) {
   GST_PAD_SET_PROXY_CAPS(self->srcpad);
   gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
 }
+
+GST_ELEMENT_REGISTER_DEFINE(neuflow, "neuflow", GST_RANK_NONE, gst_neuflow_get_type());

@@ -30,7 +30,6 @@
  * gst-launch-1.0 v4l2src ! videoconvert ! neuflow model=neuflow_mixed.pth ! neuflowshmsink shm-name=/neuflow-front
  * ]|
  */
-#include <gst/base/gstbasesink.h>
 #include <gst/gst.h>
 
 #include <exception>
@@ -40,7 +39,7 @@
 
 #include "elements.hpp"
 #include "flow_ring_writer.hpp"
-#include "neuflow/gst/flow_meta.h"
+#include "gstneuflowflowsink.hpp"
 
 GST_DEBUG_CATEGORY_STATIC(gst_neuflow_shm_sink_debug);
 #define GST_CAT_DEFAULT gst_neuflow_shm_sink_debug
@@ -50,23 +49,19 @@ enum {
   PROP_SHM_NAME,
   PROP_SLOTS,
   PROP_SHM_MODE,
-  PROP_FLOWS_WRITTEN,
-  PROP_BUFFERS_SKIPPED,
 };
 
-#define DEFAULT_SLOTS 4
-#define MAX_SLOTS 64
-#define DEFAULT_SHM_MODE 0640
+#define DEFAULT_PROP_SLOTS 4
+#define MAX_PROP_SLOTS 64
+#define DEFAULT_PROP_SHM_MODE 0640
 
 struct GstNeuflowShmSink {
-  GstBaseSink parent;
+  GstNeuflowFlowSink parent;
 
   // Properties, under the object lock.
   gchar *shm_name;
   guint slots;
   guint shm_mode;
-  guint64 flows_written;
-  guint64 buffers_skipped;
 
   // Generations continue across restarts of this element, so that a reader that saw the
   // segment of a previous run can tell the new one apart.
@@ -77,18 +72,14 @@ struct GstNeuflowShmSink {
 };
 
 struct GstNeuflowShmSinkClass {
-  GstBaseSinkClass parent_class;
+  GstNeuflowFlowSinkClass parent_class;
 };
 
 #define GST_NEUFLOW_SHM_SINK(obj) (reinterpret_cast<GstNeuflowShmSink *>(obj))
 
-G_DEFINE_TYPE_WITH_CODE(GstNeuflowShmSink, gst_neuflow_shm_sink, GST_TYPE_BASE_SINK,
+G_DEFINE_TYPE_WITH_CODE(GstNeuflowShmSink, gst_neuflow_shm_sink, GST_TYPE_NEUFLOW_FLOW_SINK,
                         GST_DEBUG_CATEGORY_INIT(gst_neuflow_shm_sink_debug, "neuflowshmsink", 0,
                                                 "NeuFlow optical flow shared-memory ring writer"))
-
-// Any raw video (any format, any memory): only the flow meta is read, never the pixels.
-static GstStaticPadTemplate sink_template =
-    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS("video/x-raw(ANY)"));
 
 static void gst_neuflow_shm_sink_set_property(GObject *object, guint prop_id, const GValue *value,
                                               GParamSpec *pspec) {
@@ -125,12 +116,6 @@ static void gst_neuflow_shm_sink_get_property(GObject *object, guint prop_id, GV
     case PROP_SHM_MODE:
       g_value_set_uint(value, self->shm_mode);
       break;
-    case PROP_FLOWS_WRITTEN:
-      g_value_set_uint64(value, self->flows_written);
-      break;
-    case PROP_BUFFERS_SKIPPED:
-      g_value_set_uint64(value, self->buffers_skipped);
-      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -154,15 +139,13 @@ static void gst_neuflow_shm_sink_finalize(GObject *object) {
 
 // Validates the name and takes the segment over, so that a typo, a clash with another
 // writer or a permission problem stops the pipeline at once rather than at the first flow.
-static gboolean gst_neuflow_shm_sink_start(GstBaseSink *sink) {
+static gboolean gst_neuflow_shm_sink_start_writing(GstNeuflowFlowSink *sink) {
   GstNeuflowShmSink *self = GST_NEUFLOW_SHM_SINK(sink);
 
   GST_OBJECT_LOCK(self);
   g_autofree gchar *name = g_strdup(self->shm_name);
   const guint slots = self->slots;
   const auto mode = static_cast<mode_t>(self->shm_mode);
-  self->flows_written = 0;
-  self->buffers_skipped = 0;
   GST_OBJECT_UNLOCK(self);
 
   if (!name || !*name) {
@@ -194,38 +177,14 @@ static gboolean gst_neuflow_shm_sink_start(GstBaseSink *sink) {
   return TRUE;
 }
 
-static gboolean gst_neuflow_shm_sink_stop(GstBaseSink *sink) {
-  GstNeuflowShmSink *self = GST_NEUFLOW_SHM_SINK(sink);
-  GST_OBJECT_LOCK(self);
-  GST_INFO_OBJECT(self, "published %" G_GUINT64_FORMAT " flows, skipped %" G_GUINT64_FORMAT " buffers without flow",
-                  self->flows_written, self->buffers_skipped);
-  GST_OBJECT_UNLOCK(self);
-  gst_neuflow_shm_sink_close(self);
-  return TRUE;
+static void gst_neuflow_shm_sink_stop_writing(GstNeuflowFlowSink *sink) {
+  gst_neuflow_shm_sink_close(GST_NEUFLOW_SHM_SINK(sink));
 }
 
-static GstFlowReturn gst_neuflow_shm_sink_render(GstBaseSink *sink, GstBuffer *buffer) {
+static GstFlowReturn gst_neuflow_shm_sink_write_flow(GstNeuflowFlowSink *sink, GstBuffer * /*buffer*/,
+                                                    const NeuflowFlowMeta *meta) {
   GstNeuflowShmSink *self = GST_NEUFLOW_SHM_SINK(sink);
-  const NeuflowFlowMeta *meta = neuflow_buffer_get_flow_meta(buffer);
-  if (!meta || meta->width == 0 || meta->height == 0) {
-    GST_OBJECT_LOCK(self);
-    ++self->buffers_skipped;
-    GST_OBJECT_UNLOCK(self);
-    GST_LOG_OBJECT(self, "buffer %" GST_TIME_FORMAT " has no flow: skipped", GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
-    return GST_FLOW_OK;
-  }
-
-  // The meta is produced by other code: its vectors must be as many as its grid says.
-  const gsize have = meta->data ? g_bytes_get_size(meta->data) : 0;
-  const guint64 need = static_cast<guint64>(meta->width) * meta->height * 2 * sizeof(gfloat);
-  if (have < need) {
-    GST_ELEMENT_ERROR(self, STREAM, FORMAT,
-                      ("Flow metadata of a %ux%u grid holds %" G_GSIZE_FORMAT " bytes of vectors, expected %" G_GUINT64_FORMAT
-                       ".",
-                       meta->width, meta->height, have, need),
-                      ("buffer %" GST_TIME_FORMAT, GST_TIME_ARGS(GST_BUFFER_PTS(buffer))));
-    return GST_FLOW_ERROR;
-  }
+  const std::size_t values = static_cast<std::size_t>(meta->width) * meta->height * 2;
 
   neuflow::gst::FlowRecord record;
   record.from_frame = meta->from_frame;
@@ -239,7 +198,7 @@ static GstFlowReturn gst_neuflow_shm_sink_render(GstBaseSink *sink, GstBuffer *b
   record.model_height = meta->model_height;
   record.iters_s16 = meta->iters_s16;
   record.iters_s8 = meta->iters_s8;
-  const std::span<const float> uv(neuflow_flow_meta_get_vectors(meta), static_cast<std::size_t>(need / sizeof(gfloat)));
+  const std::span<const float> uv(neuflow_flow_meta_get_vectors(meta), values);
 
   const std::uint64_t generation_before = self->writer->generation();
   try {
@@ -252,24 +211,19 @@ static GstFlowReturn gst_neuflow_shm_sink_render(GstBaseSink *sink, GstBuffer *b
     GST_INFO_OBJECT(self, "flow ring %s is now %ux%u, generation %" G_GUINT64_FORMAT, self->writer->name().c_str(),
                     meta->width, meta->height, self->writer->generation());
   }
-
-  GST_OBJECT_LOCK(self);
-  ++self->flows_written;
-  GST_OBJECT_UNLOCK(self);
   return GST_FLOW_OK;
 }
 
 static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
   GObjectClass *gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass *element_class = GST_ELEMENT_CLASS(klass);
-  GstBaseSinkClass *sink_class = GST_BASE_SINK_CLASS(klass);
+  GstNeuflowFlowSinkClass *flow_sink_class = GST_NEUFLOW_FLOW_SINK_CLASS(klass);
 
   gobject_class->set_property = gst_neuflow_shm_sink_set_property;
   gobject_class->get_property = gst_neuflow_shm_sink_get_property;
   gobject_class->finalize = gst_neuflow_shm_sink_finalize;
 
   constexpr auto rw_ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
-  constexpr auto ro = static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS);
 
   g_object_class_install_property(
       gobject_class, PROP_SHM_NAME,
@@ -283,43 +237,32 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
       g_param_spec_uint("slots", "Slots",
                         "Number of flows the ring holds: readers can still read a flow until this many newer ones "
                         "have been published",
-                        1, MAX_SLOTS, DEFAULT_SLOTS, rw_ready));
+                        1, MAX_PROP_SLOTS, DEFAULT_PROP_SLOTS, rw_ready));
   g_object_class_install_property(
       gobject_class, PROP_SHM_MODE,
       g_param_spec_uint("shm-mode", "Shared-memory mode",
                         "Permissions of the segment, set exactly whatever the umask (write it in octal: shm-mode=0644; "
                         "gst-launch reads a leading 0 as octal). The default 0640 lets the owner's group read: run "
                         "readers as that user or in that group. Read and write bits only, the owner's included",
-                        0600, 0666, DEFAULT_SHM_MODE, rw_ready));
-  g_object_class_install_property(
-      gobject_class, PROP_FLOWS_WRITTEN,
-      g_param_spec_uint64("flows-written", "Flows written", "Flows published into the ring since the element started",
-                          0, G_MAXUINT64, 0, ro));
-  g_object_class_install_property(
-      gobject_class, PROP_BUFFERS_SKIPPED,
-      g_param_spec_uint64("buffers-skipped", "Buffers skipped",
-                          "Buffers without flow (no NeuflowFlowMeta) since the element started", 0, G_MAXUINT64, 0,
-                          ro));
+                        0600, 0666, DEFAULT_PROP_SHM_MODE, rw_ready));
 
   gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow shared-memory sink",
                                         "Sink/Video/Analyzer",
                                         "Publishes the optical flow attached to video frames (NeuflowFlowMeta) into "
                                         "a POSIX shared-memory ring of the latest flows, for readers in other processes",
                                         "neuflow");
-  gst_element_class_add_static_pad_template(element_class, &sink_template);
-
-  sink_class->start = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_start);
-  sink_class->stop = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_stop);
-  sink_class->render = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_render);
+  flow_sink_class->start_writing = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_start_writing);
+  flow_sink_class->write_flow = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_write_flow);
+  flow_sink_class->stop_writing = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_stop_writing);
+  flow_sink_class->written_noun = "flows into the ring";
 }
 
 static void gst_neuflow_shm_sink_init(GstNeuflowShmSink *self) {
   self->shm_name = nullptr;
-  self->slots = DEFAULT_SLOTS;
-  self->shm_mode = DEFAULT_SHM_MODE;
-  self->flows_written = 0;
-  self->buffers_skipped = 0;
+  self->slots = DEFAULT_PROP_SLOTS;
+  self->shm_mode = DEFAULT_PROP_SHM_MODE;
   self->next_generation = 0;
   self->writer = nullptr;
-  gst_base_sink_set_sync(GST_BASE_SINK(self), FALSE);
 }
+
+GST_ELEMENT_REGISTER_DEFINE(neuflowshmsink, "neuflowshmsink", GST_RANK_NONE, gst_neuflow_shm_sink_get_type());

@@ -37,7 +37,6 @@
  * gst-launch-1.0 filesrc location=in.mp4 ! decodebin ! videoconvert ! neuflow ! neuflowsink location=out/flow_%05d.flo
  * ]|
  */
-#include <gst/base/gstbasesink.h>
 #include <gst/gst.h>
 
 #include <sys/stat.h>
@@ -56,11 +55,11 @@
 #include "earlier_files.hpp"
 #include "elements.hpp"
 #include "flow_index_compaction.hpp"
+#include "gstneuflowflowsink.hpp"
 #include "neuflow/flow/errors.hpp"
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/flow/flow_index.hpp"
 #include "neuflow/flow/flow_io.hpp"
-#include "neuflow/gst/flow_meta.h"
 #include "written_files.hpp"
 
 GST_DEBUG_CATEGORY_STATIC(gst_neuflow_sink_debug);
@@ -73,20 +72,20 @@ enum {
   PROP_INDEX_LOCATION,
   PROP_MAX_FILES,
   PROP_MAX_BYTES,
-  PROP_FLOWS_WRITTEN,
-  PROP_BUFFERS_SKIPPED,
 };
 
-#define DEFAULT_LOCATION "flow_%05d.flo"
-#define DEFAULT_INDEX 0
-#define DEFAULT_INDEX_LOCATION nullptr /* index.csv in the directory of location */
+#define DEFAULT_PROP_LOCATION "flow_%05d.flo"
+#define DEFAULT_PROP_INDEX 0
+#define DEFAULT_PROP_INDEX_LOCATION nullptr /* index.csv in the directory of location */
+#define DEFAULT_PROP_MAX_FILES 0            /* no limit */
+#define DEFAULT_PROP_MAX_BYTES 0
 #define INDEX_FILE_NAME "index.csv"
 // The index is compacted when it holds more than twice the rows of the files kept, but never
 // for fewer rows than this: tiny limits would otherwise rewrite it every other flow.
 #define INDEX_MIN_LIVE_ROWS 16
 
 struct GstNeuflowSink {
-  GstBaseSink parent;
+  GstNeuflowFlowSink parent;
 
   // Properties, under the object lock.
   gchar *location;
@@ -94,8 +93,6 @@ struct GstNeuflowSink {
   gint index;  // of the next file
   guint64 max_files;  // 0: no limit
   guint64 max_bytes;
-  guint64 flows_written;
-  guint64 buffers_skipped;
 
   // From start() to stop(), streaming thread only.
   gchar *pattern;          // location, validated
@@ -114,16 +111,14 @@ struct GstNeuflowSink {
 };
 
 struct GstNeuflowSinkClass {
-  GstBaseSinkClass parent_class;
+  GstNeuflowFlowSinkClass parent_class;
 };
 
 #define GST_NEUFLOW_SINK(obj) (reinterpret_cast<GstNeuflowSink *>(obj))
 
-G_DEFINE_TYPE_WITH_CODE(GstNeuflowSink, gst_neuflow_sink, GST_TYPE_BASE_SINK,
+G_DEFINE_TYPE_WITH_CODE(GstNeuflowSink, gst_neuflow_sink, GST_TYPE_NEUFLOW_FLOW_SINK,
                         GST_DEBUG_CATEGORY_INIT(gst_neuflow_sink_debug, "neuflowsink", 0,
                                                 "NeuFlow optical flow file writer"))
-
-static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS_ANY);
 
 namespace {
 
@@ -224,12 +219,6 @@ static void gst_neuflow_sink_get_property(GObject *object, guint prop_id, GValue
     case PROP_MAX_BYTES:
       g_value_set_uint64(value, self->max_bytes);
       break;
-    case PROP_FLOWS_WRITTEN:
-      g_value_set_uint64(value, self->flows_written);
-      break;
-    case PROP_BUFFERS_SKIPPED:
-      g_value_set_uint64(value, self->buffers_skipped);
-      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -299,15 +288,13 @@ static void gst_neuflow_sink_take_over_earlier_files(GstNeuflowSink *self) {
 // Validates the settings and checks that the output directories exist, so that a typo shows
 // up when the pipeline starts rather than at the first flow. Files are created only when
 // there is flow to write.
-static gboolean gst_neuflow_sink_start(GstBaseSink *sink) {
+static gboolean gst_neuflow_sink_start_writing(GstNeuflowFlowSink *sink) {
   GstNeuflowSink *self = GST_NEUFLOW_SINK(sink);
 
   GST_OBJECT_LOCK(self);
   g_autofree gchar *location = g_strdup(self->location);
   g_autofree gchar *index_location = g_strdup(self->index_location);
   const gint index = self->index;
-  self->flows_written = 0;
-  self->buffers_skipped = 0;
   GST_OBJECT_UNLOCK(self);
 
   if (!location || !*location) {
@@ -416,16 +403,11 @@ static void gst_neuflow_sink_apply_retention(GstNeuflowSink *self, const std::st
   if (self->index_rows > std::max(2 * live, self->index_compact_floor)) gst_neuflow_sink_compact_index(self);
 }
 
-static gboolean gst_neuflow_sink_stop(GstBaseSink *sink) {
+static void gst_neuflow_sink_stop_writing(GstNeuflowFlowSink *sink) {
   GstNeuflowSink *self = GST_NEUFLOW_SINK(sink);
-  GST_OBJECT_LOCK(self);
-  GST_INFO_OBJECT(self, "wrote %" G_GUINT64_FORMAT " flow files, skipped %" G_GUINT64_FORMAT " buffers without flow",
-                  self->flows_written, self->buffers_skipped);
-  GST_OBJECT_UNLOCK(self);
   // Leaves an index that lists exactly the files kept.
   if (self->index_path && self->files_removed > 0) gst_neuflow_sink_compact_index(self);
   gst_neuflow_sink_clear_run_state(self);
-  return TRUE;
 }
 
 // Appends one row to the index, opening it (and writing the header into an empty file)
@@ -472,16 +454,9 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
   return true;
 }
 
-static GstFlowReturn gst_neuflow_sink_render(GstBaseSink *sink, GstBuffer *buffer) {
+static GstFlowReturn gst_neuflow_sink_write_flow(GstNeuflowFlowSink *sink, GstBuffer * /*buffer*/,
+                                                 const NeuflowFlowMeta *meta) {
   GstNeuflowSink *self = GST_NEUFLOW_SINK(sink);
-  const NeuflowFlowMeta *meta = neuflow_buffer_get_flow_meta(buffer);
-  if (!meta || meta->width == 0 || meta->height == 0) {
-    GST_OBJECT_LOCK(self);
-    ++self->buffers_skipped;
-    GST_OBJECT_UNLOCK(self);
-    GST_LOG_OBJECT(self, "buffer %" GST_TIME_FORMAT " has no flow: skipped", GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
-    return GST_FLOW_OK;
-  }
 
   GST_OBJECT_LOCK(self);
   const gint index = self->index;
@@ -510,7 +485,6 @@ static GstFlowReturn gst_neuflow_sink_render(GstBaseSink *sink, GstBuffer *buffe
 
   GST_OBJECT_LOCK(self);
   self->index = index + 1;
-  ++self->flows_written;
   GST_OBJECT_UNLOCK(self);
   return GST_FLOW_OK;
 }
@@ -518,14 +492,13 @@ static GstFlowReturn gst_neuflow_sink_render(GstBaseSink *sink, GstBuffer *buffe
 static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
   GObjectClass *gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass *element_class = GST_ELEMENT_CLASS(klass);
-  GstBaseSinkClass *sink_class = GST_BASE_SINK_CLASS(klass);
+  GstNeuflowFlowSinkClass *flow_sink_class = GST_NEUFLOW_FLOW_SINK_CLASS(klass);
 
   gobject_class->set_property = gst_neuflow_sink_set_property;
   gobject_class->get_property = gst_neuflow_sink_get_property;
   gobject_class->finalize = gst_neuflow_sink_finalize;
 
   constexpr auto rw_ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
-  constexpr auto ro = static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS);
 
   g_object_class_install_property(
       gobject_class, PROP_LOCATION,
@@ -533,13 +506,13 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
                           "Pattern of the flow file names, with exactly one printf integer conversion for the "
                           "index (e.g. flow_%05d.flo); the extension picks the format: .flo (Middlebury), .npy "
                           "(NumPy H x W x 2 float32) or .png (KITTI 16-bit). The directory must exist",
-                          DEFAULT_LOCATION, rw_ready));
+                          DEFAULT_PROP_LOCATION, rw_ready));
   g_object_class_install_property(
       gobject_class, PROP_INDEX,
       g_param_spec_int("index", "Index",
                        "Index of the next flow file in the location pattern; incremented after each file written "
                        "(buffers without flow do not use an index)",
-                       0, G_MAXINT, DEFAULT_INDEX,
+                       0, G_MAXINT, DEFAULT_PROP_INDEX,
                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
   g_object_class_install_property(
       gobject_class, PROP_INDEX_LOCATION,
@@ -552,14 +525,14 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
                           "more than twice as many rows as files kept (at least 32 rows), and when the element "
                           "stops, so it stays bounded. Unset: index.csv in the directory of location; empty string: "
                           "no index",
-                          DEFAULT_INDEX_LOCATION, rw_ready));
+                          DEFAULT_PROP_INDEX_LOCATION, rw_ready));
   g_object_class_install_property(
       gobject_class, PROP_MAX_FILES,
       g_param_spec_uint64("max-files", "Maximum files",
                           "Keep at most this many flow files: after each file written, the oldest files this element "
                           "wrote since it started (not those of earlier runs, nor those written while no limit was "
                           "set) are deleted, oldest first, and their index rows dropped. 0: no limit",
-                          0, G_MAXUINT64, 0,
+                          0, G_MAXUINT64, DEFAULT_PROP_MAX_FILES,
                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
   g_object_class_install_property(
       gobject_class, PROP_MAX_BYTES,
@@ -567,46 +540,35 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
                           "Keep the flow files at most this many bytes in all, deleting the oldest as for max-files "
                           "(both limits hold when both are set); the newest file is always kept, even when it alone "
                           "is larger. 0: no limit",
-                          0, G_MAXUINT64, 0,
+                          0, G_MAXUINT64, DEFAULT_PROP_MAX_BYTES,
                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
-  g_object_class_install_property(
-      gobject_class, PROP_FLOWS_WRITTEN,
-      g_param_spec_uint64("flows-written", "Flows written", "Flow files written since the element started", 0,
-                          G_MAXUINT64, 0, ro));
-  g_object_class_install_property(
-      gobject_class, PROP_BUFFERS_SKIPPED,
-      g_param_spec_uint64("buffers-skipped", "Buffers skipped",
-                          "Buffers without flow (no NeuflowFlowMeta) since the element started", 0, G_MAXUINT64, 0,
-                          ro));
 
   gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow file sink", "Sink/File/Video/Analyzer",
                                         "Writes the optical flow attached to video frames (NeuflowFlowMeta) to "
                                         "numbered .flo, .npy or KITTI .png files with a CSV index",
                                         "neuflow");
-  gst_element_class_add_static_pad_template(element_class, &sink_template);
-
-  sink_class->start = GST_DEBUG_FUNCPTR(gst_neuflow_sink_start);
-  sink_class->stop = GST_DEBUG_FUNCPTR(gst_neuflow_sink_stop);
-  sink_class->render = GST_DEBUG_FUNCPTR(gst_neuflow_sink_render);
+  flow_sink_class->start_writing = GST_DEBUG_FUNCPTR(gst_neuflow_sink_start_writing);
+  flow_sink_class->write_flow = GST_DEBUG_FUNCPTR(gst_neuflow_sink_write_flow);
+  flow_sink_class->stop_writing = GST_DEBUG_FUNCPTR(gst_neuflow_sink_stop_writing);
+  flow_sink_class->written_noun = "flow files";
 }
 
 static void gst_neuflow_sink_init(GstNeuflowSink *self) {
-  self->location = g_strdup(DEFAULT_LOCATION);
-  self->index_location = nullptr;
-  self->index = DEFAULT_INDEX;
-  self->flows_written = 0;
-  self->buffers_skipped = 0;
+  self->location = g_strdup(DEFAULT_PROP_LOCATION);
+  self->index_location = DEFAULT_PROP_INDEX_LOCATION;
+  self->index = DEFAULT_PROP_INDEX;
   self->pattern = nullptr;
   self->index_path = nullptr;
   self->index_dir = nullptr;
   self->index_file = nullptr;
-  self->max_files = 0;
-  self->max_bytes = 0;
+  self->max_files = DEFAULT_PROP_MAX_FILES;
+  self->max_bytes = DEFAULT_PROP_MAX_BYTES;
   self->written = nullptr;
   self->index_rows = 0;
   self->index_rows_known = FALSE;
   self->index_foreign_rows = 0;
   self->index_compact_floor = 0;
   self->files_removed = 0;
-  gst_base_sink_set_sync(GST_BASE_SINK(self), FALSE);  // a file writer, like filesink
 }
+
+GST_ELEMENT_REGISTER_DEFINE(neuflowsink, "neuflowsink", GST_RANK_NONE, gst_neuflow_sink_get_type());

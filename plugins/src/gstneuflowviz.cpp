@@ -562,3 +562,5 @@ static void gst_neuflow_viz_init(GstNeuflowViz *self) {
   self->layout = PixelLayout{};
   self->scratch = new VizScratch();
 }
+
+GST_ELEMENT_REGISTER_DEFINE(neuflowviz, "neuflowviz", GST_RANK_NONE, gst_neuflow_viz_get_type());

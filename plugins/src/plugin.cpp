@@ -5,10 +5,10 @@
 
 static gboolean plugin_init(GstPlugin *plugin) {
   gboolean ok = TRUE;
-  ok &= gst_element_register(plugin, "neuflow", GST_RANK_NONE, gst_neuflow_get_type());
-  ok &= gst_element_register(plugin, "neuflowviz", GST_RANK_NONE, gst_neuflow_viz_get_type());
-  ok &= gst_element_register(plugin, "neuflowsink", GST_RANK_NONE, gst_neuflow_sink_get_type());
-  ok &= gst_element_register(plugin, "neuflowshmsink", GST_RANK_NONE, gst_neuflow_shm_sink_get_type());
+  ok &= GST_ELEMENT_REGISTER(neuflow, plugin);
+  ok &= GST_ELEMENT_REGISTER(neuflowviz, plugin);
+  ok &= GST_ELEMENT_REGISTER(neuflowsink, plugin);
+  ok &= GST_ELEMENT_REGISTER(neuflowshmsink, plugin);
   return ok;
 }
 

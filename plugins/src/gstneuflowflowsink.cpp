@@ -1,0 +1,137 @@
+#include "gstneuflowflowsink.hpp"
+
+GST_DEBUG_CATEGORY_STATIC(gst_neuflow_flow_sink_debug);
+#define GST_CAT_DEFAULT gst_neuflow_flow_sink_debug
+
+enum {
+  PROP_0,
+  PROP_FLOWS_WRITTEN,
+  PROP_BUFFERS_SKIPPED,
+};
+
+struct GstNeuflowFlowSinkPrivate {
+  // Under the object lock: the application may read them from any thread.
+  guint64 flows_written;
+  guint64 buffers_skipped;
+};
+
+G_DEFINE_ABSTRACT_TYPE_WITH_CODE(GstNeuflowFlowSink, gst_neuflow_flow_sink, GST_TYPE_BASE_SINK,
+                                 G_ADD_PRIVATE(GstNeuflowFlowSink)
+                                     GST_DEBUG_CATEGORY_INIT(gst_neuflow_flow_sink_debug, "neuflowflowsink", 0,
+                                                             "Base of the NeuFlow flow sinks"))
+
+// Any raw video (any format, any memory): only the flow meta is read, never the pixels.
+static GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS("video/x-raw(ANY)"));
+
+static GstNeuflowFlowSinkPrivate *gst_neuflow_flow_sink_private(GstNeuflowFlowSink *self) {
+  return static_cast<GstNeuflowFlowSinkPrivate *>(gst_neuflow_flow_sink_get_instance_private(self));
+}
+
+static void gst_neuflow_flow_sink_get_property(GObject *object, guint prop_id, GValue *value, GParamSpec *pspec) {
+  GstNeuflowFlowSink *self = GST_NEUFLOW_FLOW_SINK(object);
+  GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_FLOWS_WRITTEN:
+      g_value_set_uint64(value, priv->flows_written);
+      break;
+    case PROP_BUFFERS_SKIPPED:
+      g_value_set_uint64(value, priv->buffers_skipped);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static gboolean gst_neuflow_flow_sink_start(GstBaseSink *sink) {
+  GstNeuflowFlowSink *self = GST_NEUFLOW_FLOW_SINK(sink);
+  GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
+  GST_OBJECT_LOCK(self);
+  priv->flows_written = 0;
+  priv->buffers_skipped = 0;
+  GST_OBJECT_UNLOCK(self);
+  return GST_NEUFLOW_FLOW_SINK_GET_CLASS(self)->start_writing(self);
+}
+
+static gboolean gst_neuflow_flow_sink_stop(GstBaseSink *sink) {
+  GstNeuflowFlowSink *self = GST_NEUFLOW_FLOW_SINK(sink);
+  GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
+  GstNeuflowFlowSinkClass *klass = GST_NEUFLOW_FLOW_SINK_GET_CLASS(self);
+  GST_OBJECT_LOCK(self);
+  GST_INFO_OBJECT(self, "wrote %" G_GUINT64_FORMAT " %s, skipped %" G_GUINT64_FORMAT " buffers without flow",
+                  priv->flows_written, klass->written_noun, priv->buffers_skipped);
+  GST_OBJECT_UNLOCK(self);
+  klass->stop_writing(self);
+  return TRUE;
+}
+
+static GstFlowReturn gst_neuflow_flow_sink_render(GstBaseSink *sink, GstBuffer *buffer) {
+  GstNeuflowFlowSink *self = GST_NEUFLOW_FLOW_SINK(sink);
+  GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
+  const NeuflowFlowMeta *meta = neuflow_buffer_get_flow_meta(buffer);
+  if (!meta || meta->width == 0 || meta->height == 0) {
+    GST_OBJECT_LOCK(self);
+    ++priv->buffers_skipped;
+    GST_OBJECT_UNLOCK(self);
+    GST_LOG_OBJECT(self, "buffer %" GST_TIME_FORMAT " has no flow: skipped", GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
+    return GST_FLOW_OK;
+  }
+
+  // The meta is produced by other code: its vectors must be as many as its grid says.
+  const gsize have = meta->data ? g_bytes_get_size(meta->data) : 0;
+  const guint64 need = static_cast<guint64>(meta->width) * meta->height * 2 * sizeof(gfloat);
+  if (have < need) {
+    GST_ELEMENT_ERROR(self, STREAM, FORMAT,
+                      ("Flow metadata of a %ux%u grid holds %" G_GSIZE_FORMAT " bytes of vectors, expected %" G_GUINT64_FORMAT
+                       ".",
+                       meta->width, meta->height, have, need),
+                      ("buffer %" GST_TIME_FORMAT, GST_TIME_ARGS(GST_BUFFER_PTS(buffer))));
+    return GST_FLOW_ERROR;
+  }
+
+  const GstFlowReturn ret = GST_NEUFLOW_FLOW_SINK_GET_CLASS(self)->write_flow(self, buffer, meta);
+  if (ret == GST_FLOW_OK) {
+    GST_OBJECT_LOCK(self);
+    ++priv->flows_written;
+    GST_OBJECT_UNLOCK(self);
+  }
+  return ret;
+}
+
+static void gst_neuflow_flow_sink_class_init(GstNeuflowFlowSinkClass *klass) {
+  GObjectClass *gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass *element_class = GST_ELEMENT_CLASS(klass);
+  GstBaseSinkClass *sink_class = GST_BASE_SINK_CLASS(klass);
+
+  gobject_class->get_property = gst_neuflow_flow_sink_get_property;
+
+  constexpr auto ro = static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS);
+  g_object_class_install_property(
+      gobject_class, PROP_FLOWS_WRITTEN,
+      g_param_spec_uint64("flows-written", "Flows written",
+                          "Flows written out (files, or flows published into the ring) since the element started", 0,
+                          G_MAXUINT64, 0, ro));
+  g_object_class_install_property(
+      gobject_class, PROP_BUFFERS_SKIPPED,
+      g_param_spec_uint64("buffers-skipped", "Buffers skipped",
+                          "Buffers without flow (no NeuflowFlowMeta) since the element started", 0, G_MAXUINT64, 0,
+                          ro));
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+
+  sink_class->start = GST_DEBUG_FUNCPTR(gst_neuflow_flow_sink_start);
+  sink_class->stop = GST_DEBUG_FUNCPTR(gst_neuflow_flow_sink_stop);
+  sink_class->render = GST_DEBUG_FUNCPTR(gst_neuflow_flow_sink_render);
+  klass->written_noun = "flows";
+}
+
+static void gst_neuflow_flow_sink_init(GstNeuflowFlowSink *self) {
+  GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
+  priv->flows_written = 0;
+  priv->buffers_skipped = 0;
+  // A writer of files and memory, like filesink: each flow goes out as soon as it exists.
+  gst_base_sink_set_sync(GST_BASE_SINK(self), FALSE);
+}
