@@ -1,7 +1,7 @@
 # Environments for tests that load the plugin from the build tree.
 #   neuflow_gst_test_env(<var>) — for our (instrumented) gtest executables, whose main()
-#     (plugins/tests/gst_test_main.cpp) sets the plugin path and registry itself: under the
-#     sanitizers, LSan ignores what GLib keeps until exit on purpose (plugins/tests/lsan.supp,
+#     (tests/plugins/gst_test_main.cpp) sets the plugin path and registry itself: under the
+#     sanitizers, LSan ignores what GLib keeps until exit on purpose (tests/plugins/lsan.supp,
 #     their frames only; GLib has no frame pointers, hence the slow unwinder). One variable,
 #     since gtest_discover_tests splits lists.
 #   neuflow_gst_tool_env(<var> <registry-file>) — for GStreamer's own tools (gst-inspect-1.0):
@@ -10,7 +10,7 @@
 function(neuflow_gst_test_env var)
   set(env "")
   if(NEUFLOW_SANITIZE)
-    set(env "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/plugins/tests/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
+    set(env "LSAN_OPTIONS=suppressions=${PROJECT_SOURCE_DIR}/tests/plugins/lsan.supp:print_suppressions=0:fast_unwind_on_malloc=0")
   endif()
   set(${var} "${env}" PARENT_SCOPE)
 endfunction()

@@ -2,7 +2,7 @@
 #   neuflowd_config_tests: the file on its own (syntax, keys, types, ranges, names, paths) and
 #     the shipped examples in config/; needs nothing from the machine.
 #   neuflowd_config_machine_tests: the checks against this machine (files, devices, folders,
-#     GStreamer elements). Its main (plugins/tests/gst_test_main.cpp) calls gst_init and loads
+#     GStreamer elements). Its main (tests/plugins/gst_test_main.cpp) calls gst_init and loads
 #     the neuflow plugin from this build tree, so the element checks find it uninstalled.
 neuflow_add_test(neuflowd_config_tests SOURCES config_test.cpp config_text_test.cpp rtsp_credentials_test.cpp LIBS neuflowd_core LABELS daemon)
 target_compile_definitions(neuflowd_config_tests PRIVATE NEUFLOW_CONFIG_DIR="${PROJECT_SOURCE_DIR}/config")

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "convert_inputs.hpp"
-#include "convert_job.hpp"
-#include "convert_progress.hpp"
-#include "session_options.hpp"
+#include "convert/inputs.hpp"
+#include "convert/job.hpp"
+#include "convert/progress.hpp"
+#include "common/session_options.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "session_options.hpp"
+#include "common/session_options.hpp"
 #include "neuflow/eval/errors.hpp"
 #include "neuflow/eval/evaluate.hpp"
 #include "neuflow/eval/layouts.hpp"

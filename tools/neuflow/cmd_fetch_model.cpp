@@ -8,9 +8,9 @@
 #include <string>
 
 #include "commands.hpp"
-#include "model_fetch.hpp"
-#include "model_fetch_error.hpp"
-#include "model_fetch_hash.hpp"
+#include "fetch_model/fetch.hpp"
+#include "fetch_model/error.hpp"
+#include "fetch_model/hash.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 

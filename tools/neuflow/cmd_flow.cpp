@@ -8,7 +8,7 @@
 #include <string>
 
 #include "commands.hpp"
-#include "session_options.hpp"
+#include "common/session_options.hpp"
 #include "neuflow/flow/errors.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/flow/visualize.hpp"

@@ -1,0 +1,58 @@
+#include "common/session_options.hpp"
+
+#include <cstdio>
+
+#include "common/exit_codes.hpp"
+
+namespace neuflow::cli {
+
+void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions model_size) {
+  using L = model::SessionLimits;
+  auto& o = args.options;
+  if (model_size == ModelSizeOptions::offered) {
+    command
+        .add_option("--model-width", o.model_width,
+                    "Width the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
+        ->capture_default_str()
+        ->check(CLI::Range(0, L::max_side));
+    command
+        .add_option("--model-height", o.model_height,
+                    "Height the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
+        ->capture_default_str()
+        ->check(CLI::Range(0, L::max_side));
+    // Hidden (an empty group): the spelling of earlier releases.
+    command.add_option("--size", args.size_alias, "Same as --model-width W --model-height H")->group("");
+  }
+  command.add_option("--iters-s16", o.iterations.s16, "Refinement iterations at 1/16 resolution")
+      ->capture_default_str()
+      ->check(CLI::Range(0, L::max_iterations_s16));
+  command.add_option("--iters-s8", o.iterations.s8, "Refinement iterations at 1/8 resolution")
+      ->capture_default_str()
+      ->check(CLI::Range(0, L::max_iterations_s8));
+  command
+      .add_option("--channel-order", args.channel_order,
+                  "Colour order fed to the network: rgb (what the published weights were trained with) or bgr (as "
+                  "the reference demo scripts feed it)")
+      ->check(CLI::IsMember({"rgb", "bgr"}))
+      ->capture_default_str();
+  command.add_flag("--bgr", args.bgr_alias, "Same as --channel-order bgr")->group("");
+  command.add_option("--threads", o.threads, "CPU threads for inference (0: all cores)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, L::max_threads));
+}
+
+model::SessionOptions session_options(const SessionArgs& args) {
+  model::SessionOptions options = args.options;
+  if (!args.size_alias.empty()) {
+    char rest = 0;
+    if (std::sscanf(args.size_alias.c_str(), "%dx%d%c", &options.model_width, &options.model_height, &rest) != 2) {
+      throw CommandError(kExitFailure, "--size wants WIDTHxHEIGHT (multiples of 16), got '" + args.size_alias + "'");
+    }
+  }
+  options.network_order = args.bgr_alias ? model::ChannelOrder::bgr
+                                         : model::parse_channel_order(args.channel_order).value_or(model::ChannelOrder::rgb);
+  if (auto problem = model::check_session_options(options)) throw CommandError(kExitFailure, "--" + *problem);
+  return options;
+}
+
+}  // namespace neuflow::cli

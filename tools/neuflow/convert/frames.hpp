@@ -1,0 +1,42 @@
+#pragma once
+// The frames of one `neuflow convert` input, in order, whatever it is: the two images of a
+// pair, the images of a folder in natural order, or the frames of a video.
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "convert/inputs.hpp"
+#include "neuflow/model/flow_session.hpp"
+#include "neuflow/pipeline/frame_rate.hpp"
+
+namespace neuflow::cli {
+
+struct Frame {
+  cv::Mat pixels;                    // 8-bit, 3 channels
+  model::ChannelOrder data_order;    // how `pixels` holds them (OpenCV: BGR, GStreamer: RGB)
+  std::int64_t number = 0;           // 0-based position in the input
+  std::optional<std::int64_t> pts_ns;  // video frames' presentation time
+  std::string source;  // the image's file name; empty for video frames
+  // Base name of the outputs of the pair that starts at this frame: the image's stem (its
+  // whole file name where two images of the folder share a stem), or frame_000123 for video.
+  std::string output_stem;
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  // The next frame, or nullopt after the last. Throws InputError naming the file at fault.
+  virtual std::optional<Frame> next() = 0;
+  // How many frames the input has, when known (for a video: an estimate, after next()).
+  virtual std::optional<std::int64_t> frame_count() const = 0;
+  // The rate for an encoded visualization; unknown for images.
+  virtual pipeline::FrameRate frame_rate() const = 0;
+};
+
+// Throws InputError when the input cannot be opened (missing, an empty folder…).
+std::unique_ptr<FrameSource> open_frames(const InputSpec& input);
+
+}  // namespace neuflow::cli

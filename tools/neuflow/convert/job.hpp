@@ -1,0 +1,49 @@
+#pragma once
+// Converting one input of `neuflow convert`: every consecutive pair of its frames through
+// the streaming session, each flow written to its own file, optionally rendered, and the
+// sidecar index.
+//
+// Output layout, in <output>/<input's output_name>/:
+//   <stem>.flo|.npy|.png  the flow from the frame named <stem> to the next one: the image's
+//                          stem for folders and pairs, frame_000123 (frame 123 → 124) for
+//                          videos
+//   viz/<stem>.png         its colour rendering (--viz png)
+//   viz.mp4                all renderings as an H.264 video (--viz video)
+//   index.csv              one row per pair (see convert_index.hpp)
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "convert/input_error.hpp"
+#include "convert/inputs.hpp"
+#include "convert/progress.hpp"
+#include "neuflow/flow/flow_io.hpp"
+#include "neuflow/model/flow_session.hpp"
+
+namespace neuflow::cli {
+
+enum class VizMode { none, png, video };
+
+struct ConvertSettings {
+  std::filesystem::path output_dir;
+  flow::FlowFormat format = flow::FlowFormat::flo;
+  VizMode viz = VizMode::none;
+  double max_flow = 20;  // px at full saturation, fixed so colours mean the same in every frame
+  bool resume = false;   // keep flow files that exist and read back at the right size
+  std::int64_t max_frames = 0;  // 0: every frame; else only the first max_frames of each input
+};
+
+struct InputOutcome {
+  std::filesystem::path output;  // the input's output folder
+  std::int64_t pairs_written = 0;  // flows computed and written
+  std::int64_t pairs_skipped = 0;  // flows kept from an earlier run (--resume)
+  double seconds = 0;
+  std::optional<InputError> error;
+};
+
+// Never throws for a problem with the input or its outputs: that ends up in error, after
+// whatever could be written (and the index of it) has been written.
+InputOutcome convert_input(const InputSpec& input, model::FlowSession& session, const ConvertSettings& settings,
+                           Progress& progress);
+
+}  // namespace neuflow::cli
