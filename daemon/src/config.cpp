@@ -89,4 +89,20 @@ Config parse_config(const std::string& text, const std::filesystem::path& file, 
   return std::move(result.config);
 }
 
+pipeline::GraphDescription graph_description(const StreamConfig& stream, int threads) {
+  pipeline::GraphDescription graph;
+  graph.name = stream.name;
+  graph.source = stream.source.settings;
+  const FlowConfig& f = stream.flow;
+  graph.flow.model = f.model;
+  graph.flow.session.iterations = {f.iters_s16, f.iters_s8};
+  graph.flow.session.model_width = f.model_width;
+  graph.flow.session.model_height = f.model_height;
+  graph.flow.session.threads = threads;
+  graph.flow.session.network_order = model::parse_channel_order(f.channel_order).value_or(model::ChannelOrder::rgb);
+  graph.flow.behaviour = f.behaviour;
+  for (const SinkConfig& sink : stream.sinks) graph.sinks.push_back({sink.name, sink.settings});
+  return graph;
+}
+
 }  // namespace neuflow::daemon

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "neuflow/model/session_settings.hpp"
+#include "neuflow/pipeline/graph_description.hpp"
 
 namespace neuflow::daemon {
 
@@ -25,42 +26,13 @@ struct SourcePosition {
 
 // ---- sources -------------------------------------------------------------------------------
 
-// Optional caps for camera and test sources; 0 leaves the choice to negotiation.
-struct VideoMode {
-  int width = 0;
-  int height = 0;
-  int framerate_num = 0;  // `framerate = 30` or `framerate = "30000/1001"`
-  int framerate_den = 1;
-  bool operator==(const VideoMode&) const = default;
-};
+using pipeline::LibcameraSource;
+using pipeline::TestSource;
+using pipeline::UriSource;
+using pipeline::V4l2Source;
+using pipeline::VideoMode;
 
-struct V4l2Source {       // type = "v4l2"
-  std::string device = "/dev/video0";
-  VideoMode mode;
-  bool mjpeg = false;     // `format = "mjpeg"`: ask the camera for JPEG and decode it
-  bool operator==(const V4l2Source&) const = default;
-};
-
-struct LibcameraSource {  // type = "libcamera"
-  std::string camera;     // libcamerasrc camera-name; empty: the first camera
-  VideoMode mode;
-  bool operator==(const LibcameraSource&) const = default;
-};
-
-struct UriSource {        // type = "uri"
-  std::string uri;        // file://, rtsp://, http(s)://; a plain path in the file is made a file:// URI
-  bool operator==(const UriSource&) const = default;
-};
-
-struct TestSource {       // type = "test"
-  std::string pattern = "ball";  // a videotestsrc pattern nick
-  VideoMode mode;                // defaults applied by the graph: 320x240 at 30/1
-  int frames = -1;               // `frames = N`: end of stream after N frames; -1: endless
-  bool live = true;              // paced like a camera
-  bool operator==(const TestSource&) const = default;
-};
-
-using SourceSettings = std::variant<V4l2Source, LibcameraSource, UriSource, TestSource>;
+using SourceSettings = pipeline::SourceDescription;
 
 struct SourceConfig {
   SourceSettings settings;
@@ -70,7 +42,8 @@ struct SourceConfig {
 
 // ---- flow ----------------------------------------------------------------------------------
 
-// The neuflow element's properties, under the same names in the file.
+// The neuflow element's properties, under the same names in the file (the graph's FlowStage:
+// flow_stage()).
 struct FlowConfig {
   std::filesystem::path model;   // model = "/var/lib/neuflow/neuflow_mixed.pth" (required)
   int iters_s16 = model::Iterations{}.s16;  // iters-s16
@@ -86,41 +59,12 @@ struct FlowConfig {
 
 // ---- sinks ---------------------------------------------------------------------------------
 
-struct FilesSink {        // type = "files"
-  std::filesystem::path directory;    // required; created if missing
-  std::string format = "flo";         // flo | npy | png
-  std::uint64_t max_files = 0;        // max-files: oldest removed first; 0 = no limit
-  std::uint64_t max_bytes = 0;        // max-bytes: same, by total size; 0 = no limit
-  bool operator==(const FilesSink&) const = default;
-};
+using pipeline::DisplaySink;
+using pipeline::FilesSink;
+using pipeline::ShmSink;
+using pipeline::VideoSink;
 
-struct ShmSink {          // type = "shm"
-  std::string name;       // POSIX shm name, e.g. "/neuflow-front" (required, leading '/')
-  int slots = 4;          // the latest N flows
-  unsigned mode = 0640;   // shm-mode = "0640" (or 0o640): the segment's permissions
-  bool operator==(const ShmSink&) const = default;
-};
-
-// The encoded (H.264) colour visualization. Exactly one of `file`, `rtsp`, `udp` is given.
-struct VideoSink {        // type = "video"
-  enum class Target { file, rtsp, udp };
-  Target target = Target::file;
-  std::filesystem::path file;         // file = ".../viz-%05d.mp4" (.mp4 or .mkv)
-  int segment_seconds = 0;            // segment-seconds: a new file every N s; 0 = one file
-  std::string rtsp_mount;             // rtsp = "/front": a mount on the [rtsp] server
-  std::string udp_host;               // udp = "192.168.1.10:5000": RTP/H.264 over UDP
-  int udp_port = 0;
-  int bitrate_kbps = 2000;            // bitrate (kbit/s)
-  double max_flow = 20.0;             // max-flow: px of full colour saturation
-  bool operator==(const VideoSink&) const = default;
-};
-
-struct DisplaySink {      // type = "display": a window, for debugging
-  double max_flow = 20.0;
-  bool operator==(const DisplaySink&) const = default;
-};
-
-using SinkSettings = std::variant<FilesSink, ShmSink, VideoSink, DisplaySink>;
+using SinkSettings = pipeline::SinkDescription;
 
 struct SinkConfig {
   std::string name;       // `name = "..."`, default "<type>-<index>"; used in logs and metrics
@@ -186,6 +130,9 @@ struct Config {
   // What the machine lacks now (ConfigChecks::all): logged, never fatal.
   std::vector<ConfigIssue> warnings;
 };
+
+// The stream as the graph library builds it; its flow element gets `threads` (the stream's share).
+pipeline::GraphDescription graph_description(const StreamConfig& stream, int threads);
 
 // ---- loading -------------------------------------------------------------------------------
 

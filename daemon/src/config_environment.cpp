@@ -10,10 +10,13 @@
 #include <map>
 #include <set>
 
-#include "config_elements.hpp"
 
 namespace neuflow::daemon {
 namespace {
+
+// The elements of this project's plugin (libgstneuflow.so).
+bool is_neuflow_element(const std::string& factory) { return factory.starts_with("neuflow"); }
+
 
 namespace fs = std::filesystem;
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "config_elements.hpp"
+#include "neuflow/pipeline/graph_plan.hpp"
 #include "config_read.hpp"
 #include "config_values.hpp"
 
@@ -173,7 +173,7 @@ bool read_sink(const TableReader& t, std::size_t index, const std::string& strea
   if (*type == "shm") out.settings = read_shm(t, user, context);
   if (*type == "video") out.settings = read_video(t, user, context);
   if (*type == "display") out.settings = read_display(t);
-  context.need_elements(elements_for(out.settings), user, out.where);
+  context.need_elements(pipeline::required_elements(out.settings), user, out.where);
   return true;
 }
 

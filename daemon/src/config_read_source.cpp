@@ -4,7 +4,7 @@
 #include <array>
 #include <climits>
 
-#include "config_elements.hpp"
+#include "neuflow/pipeline/graph_plan.hpp"
 #include "config_read.hpp"
 #include "config_values.hpp"
 
@@ -148,7 +148,7 @@ SourceConfig read_source(const TableReader& t, const std::string& stream, ReadCo
   if (*type == "libcamera") source.settings = read_libcamera(t);
   if (*type == "uri") source.settings = read_uri(t, user, context);
   if (*type == "test") source.settings = read_test(t);
-  context.need_elements(elements_for(source.settings), user, source.where);
+  context.need_elements(pipeline::required_elements(source.settings), user, source.where);
   return source;
 }
 

@@ -2,10 +2,10 @@
 #include <array>
 #include <map>
 
-#include "config_elements.hpp"
 #include "config_read.hpp"
 #include "config_values.hpp"
 #include "neuflow/model/session_settings.hpp"
+#include "neuflow/pipeline/graph_plan.hpp"
 
 namespace neuflow::daemon {
 namespace {
@@ -81,7 +81,7 @@ StreamConfig read_stream(const TableReader& t, std::size_t index, ReadContext& c
   if (const auto* flow = t.table("flow", Need::required, "a [stream.flow] table with at least the model")) {
     const TableReader reader(*flow, "[stream.flow]", context.issues);
     s.flow = read_flow(reader, context);
-    context.need_elements(elements_for_flow(), "stream '" + label + "'", reader.where());
+    context.need_elements(pipeline::required_elements(pipeline::FlowStage{}), "stream '" + label + "'", reader.where());
   }
   const auto* sinks = t.table_array("sink", Need::required,
                                     "at least one [[stream.sink]] table of type \"files\", \"shm\", \"video\" or "

@@ -6,7 +6,7 @@
 
 #include "log.hpp"
 #include "rtsp_credentials.hpp"
-#include "stream_graph.hpp"
+#include "neuflow/pipeline/graph_plan.hpp"
 
 namespace neuflow::daemon {
 
@@ -16,12 +16,6 @@ namespace {
 constexpr const char* kViewerRole = "viewer";
 
 bool on_all_interfaces(const std::string& address) { return address == "0.0.0.0" || address == "::"; }
-
-std::string launch_line(const RtspMount& m) {
-  return "( intervideosrc channel=\"" + m.channel + "\" ! videoconvert ! video/x-raw,format=I420 ! "
-         "x264enc tune=zerolatency speed-preset=ultrafast key-int-max=30 bitrate=" + std::to_string(m.bitrate_kbps) +
-         " ! rtph264pay name=pay0 pt=96 config-interval=1 )";
-}
 
 }  // namespace
 
@@ -114,7 +108,7 @@ void RtspServer::set_mounts(const std::map<std::string, RtspMount>& mounts) {
     auto it = mounts_.find(path);
     if (it != mounts_.end() && it->second == mount) continue;
     GstRTSPMediaFactory* factory = gst_rtsp_media_factory_new();
-    gst_rtsp_media_factory_set_launch(factory, launch_line(mount).c_str());
+    gst_rtsp_media_factory_set_launch(factory, pipeline::rtsp_launch_line(mount.channel, mount.bitrate_kbps).c_str());
     gst_rtsp_media_factory_set_shared(factory, TRUE);
     if (!settings_.credentials.empty()) {
       // Without a permission for it, a role is refused: only the listed users may watch.
@@ -137,7 +131,7 @@ std::map<std::string, RtspMount> rtsp_mounts(const Config& config) {
     for (const SinkConfig& sink : stream.sinks) {
       const auto* v = std::get_if<VideoSink>(&sink.settings);
       if (!v || v->target != VideoSink::Target::rtsp) continue;
-      mounts[v->rtsp_mount] = RtspMount{rtsp_channel_name(stream.name, v->rtsp_mount), v->bitrate_kbps};
+      mounts[v->rtsp_mount] = RtspMount{pipeline::rtsp_channel_name(stream.name, v->rtsp_mount), v->bitrate_kbps};
     }
   }
   return mounts;

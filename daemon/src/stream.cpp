@@ -103,7 +103,7 @@ void Stream::start() {
   ++run_;
   const std::string instance = config_.name + (run_ > 1 ? "#" + std::to_string(run_) : "");
   try {
-    graph_ = build_stream_graph(config_, threads_, instance);
+    graph_ = pipeline::build_stream_graph(graph_description(config_, threads_), instance);
   } catch (const std::exception& e) {
     graph_.reset();
     fail(std::string("cannot build the pipeline: ") + e.what());

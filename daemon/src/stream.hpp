@@ -13,9 +13,13 @@
 #include <string>
 
 #include "config.hpp"
-#include "stream_graph.hpp"
+#include "neuflow/pipeline/stream_graph.hpp"
 
 namespace neuflow::daemon {
+
+using pipeline::SinkBranch;
+using pipeline::StreamGraph;
+using pipeline::UnbuiltSink;
 
 enum class StreamState { idle, starting, playing, backoff, stopping, stopped, finished };
 const char* to_string(StreamState state);

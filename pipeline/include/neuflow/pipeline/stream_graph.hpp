@@ -1,5 +1,6 @@
 #pragma once
-// One stream's GStreamer pipeline, built from its config:
+// A capture → flow → sink graph as a GStreamer pipeline, built from its description by way of
+// its plan (graph_plan.hpp):
 //
 //   source → videoconvert → neuflow → tee ─┬→ queue → <sink branch 0>
 //                                           └→ queue → <sink branch 1> …
@@ -16,13 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "config.hpp"
+#include "neuflow/pipeline/graph_description.hpp"
 
-namespace neuflow::daemon {
+namespace neuflow::pipeline {
 
 struct SinkBranch {
-  std::string name;               // SinkConfig::name
-  std::string kind;               // "files", "shm", "video", "display"
+  std::string name;               // NamedSink::name
+  std::string kind;               // sink_kind(): "files", "shm", "video-file", "rtsp", "udp", "display"
   GstElement* bin = nullptr;      // our reference; in the pipeline until removed
   GstPad* tee_pad = nullptr;      // our reference to the tee's request pad
   std::atomic<bool> failed{false};
@@ -57,7 +58,7 @@ class StreamGraph {
   size_t live_branches() const;
 
  private:
-  friend std::unique_ptr<StreamGraph> build_stream_graph(const StreamConfig&, int, const std::string&);
+  friend std::unique_ptr<StreamGraph> build_stream_graph(const GraphDescription&, const std::string&);
   GstElement* pipeline_ = nullptr;
   GstElement* flow_ = nullptr;
   GstElement* tee_ = nullptr;
@@ -65,18 +66,11 @@ class StreamGraph {
   std::vector<UnbuiltSink> unbuilt_;
 };
 
-// The intervideo channel that carries a stream's visualization to an RTSP mount.
-std::string rtsp_channel_name(const std::string& stream, const std::string& mount);
+// Builds the pipeline in NULL state; the flow element gets description.flow.session.threads.
+// `instance` names the pipeline ("front" or "front#3" after restarts) in GStreamer's logs. A
+// sink that cannot be built (its folder cannot be created, an element is missing) is left out
+// and listed in unbuilt_sinks(); throws std::runtime_error naming the element or sink when the
+// source, the flow stage or every sink cannot be built.
+std::unique_ptr<StreamGraph> build_stream_graph(const GraphDescription& description, const std::string& instance);
 
-// Builds the pipeline in NULL state. `threads` is the inference threads this stream gets;
-// `instance` names the pipeline ("front" or "front#3" after restarts) in GStreamer's logs.
-// A sink that cannot be built is left out and listed in unbuilt_sinks(); throws
-// std::runtime_error naming the element or sink when the source, the flow stage or every sink
-// cannot be built.
-std::unique_ptr<StreamGraph> build_stream_graph(const StreamConfig& config, int threads, const std::string& instance);
-
-// The first index not used yet by files matching printf-style `pattern` ("…%05d…") in its
-// folder, so a restarted stream never overwrites what an earlier run wrote.
-int next_free_index(const std::string& pattern);
-
-}  // namespace neuflow::daemon
+}  // namespace neuflow::pipeline
