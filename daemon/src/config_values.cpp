@@ -3,6 +3,8 @@
 #include <array>
 #include <charconv>
 
+#include "neuflow/flow_ring.hpp"
+
 namespace neuflow::daemon {
 namespace {
 
@@ -64,20 +66,14 @@ std::optional<HostPort> parse_host_port(std::string_view text, std::string& erro
 }
 
 std::string check_shm_name(std::string_view name) {
-  const std::string expected = "a name like \"/neuflow-front\": '/' then 1 to 254 characters from A-Z a-z 0-9 . _ -";
-  if (name.size() < 2 || name.size() > 255 || name.front() != '/') return expected;
-  for (const char c : name.substr(1)) {
-    if (!is_name_char(c) && c != '.') return expected;
-  }
-  return {};
+  const std::string problem = ring::segment_name_problem(name);
+  return problem.empty() ? std::string() : "a name like \"/neuflow-front\" (" + problem + ")";
 }
 
 std::string check_shm_mode(unsigned mode) {
-  // The rule of neuflowshmsink's shm-mode, which refuses anything else at start.
-  if ((mode & ~0666u) != 0 || (mode & 0600u) != 0600u) {
-    return "an octal mode like \"0640\" (or 0o640) with read/write bits only, at least 0600 and at most 0666";
-  }
-  return {};
+  // The ring's own rule (neuflowshmsink refuses anything else at start), in the config's words.
+  if (ring::segment_mode_problem(mode).empty()) return {};
+  return "an octal mode like \"0640\" (or 0o640) with read/write bits only, at least 0600 and at most 0666";
 }
 
 std::optional<unsigned> parse_octal_mode(std::string_view text) {

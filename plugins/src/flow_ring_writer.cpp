@@ -67,24 +67,13 @@ void mark_closed(int fd) {
 }  // namespace
 
 std::optional<std::string> check_flow_ring_name(std::string_view name) {
-  if (name.empty()) return "it is empty; expected \"/name\", e.g. \"/neuflow-front\"";
-  if (name.front() != '/') return "it must start with '/', e.g. \"/neuflow-front\"";
-  if (name.size() == 1) return "it needs a name after the '/', e.g. \"/neuflow-front\"";
-  if (name.find('/', 1) != std::string_view::npos) return "it must not contain a '/' after the first character";
-  if (name.size() - 1 > NAME_MAX) return "it is longer than " + std::to_string(NAME_MAX) + " characters after the '/'";
-  if (name == "/." || name == "/..") return "\".\" and \"..\" are not segment names";
-  for (char c : name) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "it contains a control character";
-  }
-  return std::nullopt;
+  std::string problem = ring::segment_name_problem(name);
+  return problem.empty() ? std::nullopt : std::optional<std::string>(std::move(problem));
 }
 
 std::optional<std::string> check_flow_ring_mode(mode_t mode) {
-  if ((mode & ~static_cast<mode_t>(0666)) != 0) {
-    return "only read and write permission bits are allowed (at most 0666), no execute, setuid, setgid or sticky bits";
-  }
-  if ((mode & 0600) != 0600) return "the owner must keep read and write permission (at least 0600)";
-  return std::nullopt;
+  std::string problem = ring::segment_mode_problem(static_cast<unsigned>(mode));
+  return problem.empty() ? std::nullopt : std::optional<std::string>(std::move(problem));
 }
 
 FlowRingWriter::FlowRingWriter(std::string name, std::uint32_t slots, std::uint64_t first_generation, mode_t mode)

@@ -11,6 +11,8 @@
 #include <string>
 
 #include "config_test_util.hpp"
+#include "config_values.hpp"
+#include "neuflow/flow_ring.hpp"
 
 namespace neuflow::daemon {
 namespace {
@@ -841,6 +843,34 @@ TEST(ConfigExamples, QuickStartDemoWritesIntoTheRepository) {
   ASSERT_EQ(s.sinks.size(), 2u);
   EXPECT_EQ(std::get<VideoSink>(s.sinks[0].settings).file.parent_path(), repository / "out/demo");
   EXPECT_EQ(std::get<FilesSink>(s.sinks[1].settings).directory, repository / "out/demo/flow");
+}
+
+}  // namespace
+}  // namespace neuflow::daemon
+
+namespace neuflow::daemon {
+namespace {
+
+// The config accepts exactly the shared-memory names and modes neuflowshmsink accepts (one rule,
+// in neuflow/flow_ring.hpp), so a config that passes never fails at the element's start.
+TEST(ConfigValues, ShmNameAndModeFollowTheRingsOwnRules) {
+  const auto shm_sink = [](const std::string& name) {
+    return "[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
+           "sink = [ { type = \"shm\", shm-name = \"" + name + "\" } ]\n";
+  };
+  for (const std::string& good : {"/" + std::string(ring::kMaxSegmentNameLength, 'a'), std::string("/cam@front+2")}) {
+    EXPECT_TRUE(ring::segment_name_problem(good).empty()) << good;
+    EXPECT_EQ(std::get<ShmSink>(parse(shm_sink(good)).streams[0].sinks[0].settings).name, good);
+  }
+  for (const std::string& bad : {"/" + std::string(ring::kMaxSegmentNameLength + 1, 'a'), std::string("/a/b"),
+                                std::string("/.."), std::string("noslash")}) {
+    EXPECT_FALSE(ring::segment_name_problem(bad).empty()) << bad;
+    EXPECT_TRUE(has_issue(issues_of(shm_sink(bad)), 5, 0, "shm-name: expected a name like \"/neuflow-front\" ("))
+        << bad;
+  }
+  for (unsigned mode = 0; mode <= 07777; ++mode) {
+    EXPECT_EQ(check_shm_mode(mode).empty(), ring::segment_mode_problem(mode).empty()) << mode;
+  }
 }
 
 }  // namespace

@@ -4,7 +4,8 @@
 #   neuflowd_config_machine_tests: the checks against this machine (files, devices, folders,
 #     GStreamer elements). Its main (tests/plugins/gst_test_main.cpp) calls gst_init and loads
 #     the neuflow plugin from this build tree, so the element checks find it uninstalled.
-neuflow_add_test(neuflowd_config_tests SOURCES config_test.cpp config_text_test.cpp rtsp_credentials_test.cpp LIBS neuflowd_core LABELS daemon)
+neuflow_add_test(neuflowd_config_tests SOURCES config_test.cpp config_text_test.cpp rtsp_credentials_test.cpp
+                 LIBS neuflowd_core neuflow::flow_ring LABELS daemon)
 target_compile_definitions(neuflowd_config_tests PRIVATE NEUFLOW_CONFIG_DIR="${PROJECT_SOURCE_DIR}/config")
 
 if(TARGET neuflow_gst_test_main)

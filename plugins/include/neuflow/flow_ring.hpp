@@ -27,6 +27,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <thread>
 #include <utility>
@@ -47,6 +48,36 @@ inline constexpr std::uint32_t kLayoutVersion = 1;
 inline constexpr std::uint32_t kValueLayoutF32UV = 1;
 // A timestamp the writer did not know (GStreamer's GST_CLOCK_TIME_NONE).
 inline constexpr std::uint64_t kNoTimestamp = std::numeric_limits<std::uint64_t>::max();
+
+// The rules for a ring's name and mode, the same for the element, neuflowd's config check and
+// readers. A POSIX shared-memory name: '/' then 1 to NAME_MAX (255) characters, no other '/'.
+inline constexpr std::size_t kMaxSegmentNameLength = 255;
+
+// Why `name` cannot name a flow ring, or an empty string.
+inline std::string segment_name_problem(std::string_view name) {
+  if (name.empty()) return "it is empty; expected \"/name\", e.g. \"/neuflow-front\"";
+  if (name.front() != '/') return "it must start with '/', e.g. \"/neuflow-front\"";
+  if (name.size() == 1) return "it needs a name after the '/', e.g. \"/neuflow-front\"";
+  if (name.find('/', 1) != std::string_view::npos) return "it must not contain a '/' after the first character";
+  if (name.size() - 1 > kMaxSegmentNameLength) {
+    return "it is longer than " + std::to_string(kMaxSegmentNameLength) + " characters after the '/'";
+  }
+  if (name == "/." || name == "/..") return "\".\" and \"..\" are not segment names";
+  for (const char c : name) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "it contains a control character";
+  }
+  return {};
+}
+
+// Why `mode` cannot be a ring's permissions, or an empty string: read and write bits only (no
+// execute, setuid, setgid or sticky bits), and the owner must be able to read and write.
+inline std::string segment_mode_problem(unsigned mode) {
+  if ((mode & ~0666u) != 0) {
+    return "only read and write permission bits are allowed (at most 0666), no execute, setuid, setgid or sticky bits";
+  }
+  if ((mode & 0600u) != 0600u) return "the owner must keep read and write permission (at least 0600)";
+  return {};
+}
 
 enum class SegmentState : std::uint32_t {
   initializing = 0,  // being created, or waiting for the first flow: retry later
