@@ -34,6 +34,9 @@
 #include <vector>
 
 #include "elements.hpp"
+#include "flow_meta_attach.hpp"
+#include "flow_stats.hpp"
+#include "frame_converter.hpp"
 #include "frame_handoff.hpp"
 #include "neuflow/gst/flow_meta.h"
 #include "neuflow/model/checkpoint.hpp"
@@ -98,19 +101,6 @@ void release(Item &item) {
   item = {};
 }
 
-struct Stats {
-  guint64 frames_in = 0;
-  guint64 processed = 0;  // frames that left, with or without flow
-  guint64 flows = 0;      // frames that left with flow
-  guint64 dropped = 0;
-  double inference_seconds = 0;  // sum over flows
-  double last_inference_seconds = 0;
-  double latency_estimate = 0;   // moving average of recent inference times
-  double announced_latency = 0;  // the estimate last announced with a LATENCY message
-  std::chrono::steady_clock::time_point started{};
-  std::chrono::steady_clock::time_point last_message{};
-};
-
 using Handoff = neuflow::gst::FrameHandoff<Item>;
 
 void release_all(std::vector<Item> items) {
@@ -134,7 +124,7 @@ struct State {
   std::mutex lock;                   // guards what follows, up to the worker-only state
   std::optional<bool> live;          // resolved from the behaviour and upstream's liveness
   GstSegment segment{};
-  Stats stats;
+  neuflow::gst::FlowStats stats;
   guint64 next_frame = 0;
 
   // Worker-only state (no lock needed: only the inference worker touches it while it runs;
@@ -142,8 +132,7 @@ struct State {
   std::unique_ptr<FlowSession> session;
   GstVideoInfo info{};
   bool have_info = false;
-  GstVideoConverter *converter = nullptr;
-  std::vector<guint8> rgb;
+  neuflow::gst::FrameConverter converter;
   GstClockTime previous_pts = GST_CLOCK_TIME_NONE;
   guint64 previous_frame = 0;
 };
@@ -222,59 +211,18 @@ void pause_inference(State &st) {
 
 // ---- worker side ---------------------------------------------------------------------------
 
-void post_stats(GstNeuflow *self, const Stats &s) {
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - s.started).count();
+void post_stats(GstNeuflow *self, const neuflow::gst::FlowStats &s) {
+  const auto now = std::chrono::steady_clock::now();
   GstStructure *st = gst_structure_new(
-      "neuflow-stats", "frames-in", G_TYPE_UINT64, s.frames_in, "frames-processed", G_TYPE_UINT64, s.processed,
-      "flows", G_TYPE_UINT64, s.flows, "frames-dropped", G_TYPE_UINT64, s.dropped, "mean-latency", G_TYPE_DOUBLE,
-      s.flows ? 1e3 * s.inference_seconds / static_cast<double>(s.flows) : 0.0, "processing-rate", G_TYPE_DOUBLE,
-      elapsed > 0 ? static_cast<double>(s.processed) / elapsed : 0.0, nullptr);
+      "neuflow-stats", "frames-in", G_TYPE_UINT64, s.frames_in(), "frames-processed", G_TYPE_UINT64, s.processed(),
+      "flows", G_TYPE_UINT64, s.flows(), "frames-dropped", G_TYPE_UINT64, s.frames_dropped(), "mean-latency",
+      G_TYPE_DOUBLE, s.mean_latency_ms(), "processing-rate", G_TYPE_DOUBLE, s.processing_rate(now), nullptr);
   gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), st));
-}
-
-// The frame as packed RGB or BGR for the session (which feeds the network the order its
-// options ask for), converting other formats.
-neuflow::model::ImageView frame_view(State &st, GstVideoFrame &frame) {
-  const GstVideoFormat format = GST_VIDEO_INFO_FORMAT(&st.info);
-  const int width = GST_VIDEO_INFO_WIDTH(&st.info), height = GST_VIDEO_INFO_HEIGHT(&st.info);
-  if (format == GST_VIDEO_FORMAT_RGB || format == GST_VIDEO_FORMAT_BGR) {
-    return {static_cast<const std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(&frame, 0)), width, height,
-            GST_VIDEO_FRAME_PLANE_STRIDE(&frame, 0),
-            format == GST_VIDEO_FORMAT_RGB ? ChannelOrder::rgb : ChannelOrder::bgr};
-  }
-  GstVideoFrame out;
-  GstVideoInfo rgb_info;
-  gst_video_info_set_format(&rgb_info, GST_VIDEO_FORMAT_RGB, width, height);
-  st.rgb.resize(GST_VIDEO_INFO_SIZE(&rgb_info));
-  GstBuffer *wrapped = gst_buffer_new_wrapped_full(GST_MEMORY_FLAG_NO_SHARE, st.rgb.data(), st.rgb.size(), 0,
-                                                   st.rgb.size(), nullptr, nullptr);
-  gst_video_frame_map(&out, &rgb_info, wrapped, GST_MAP_WRITE);
-  gst_video_converter_frame(st.converter, &frame, &out);
-  const neuflow::model::ImageView view{st.rgb.data(), width, height, GST_VIDEO_FRAME_PLANE_STRIDE(&out, 0),
-                                       ChannelOrder::rgb};
-  gst_video_frame_unmap(&out);
-  gst_buffer_unref(wrapped);
-  return view;
 }
 
 bool set_format(GstNeuflow *self, State &st, GstCaps *caps) {
   GstVideoInfo info;
-  if (!gst_video_info_from_caps(&info, caps)) return false;
-  if (st.converter) gst_video_converter_free(st.converter);
-  st.converter = nullptr;
-  const GstVideoFormat format = GST_VIDEO_INFO_FORMAT(&info);
-  if (format != GST_VIDEO_FORMAT_RGB && format != GST_VIDEO_FORMAT_BGR) {
-    GstVideoInfo rgb_info;
-    gst_video_info_set_format(&rgb_info, GST_VIDEO_FORMAT_RGB, GST_VIDEO_INFO_WIDTH(&info),
-                              GST_VIDEO_INFO_HEIGHT(&info));
-    // The converter insists on matching rates and aspect; only the format changes.
-    GST_VIDEO_INFO_FPS_N(&rgb_info) = GST_VIDEO_INFO_FPS_N(&info);
-    GST_VIDEO_INFO_FPS_D(&rgb_info) = GST_VIDEO_INFO_FPS_D(&info);
-    GST_VIDEO_INFO_PAR_N(&rgb_info) = GST_VIDEO_INFO_PAR_N(&info);
-    GST_VIDEO_INFO_PAR_D(&rgb_info) = GST_VIDEO_INFO_PAR_D(&info);
-    st.converter = gst_video_converter_new(&info, &rgb_info, nullptr);
-    if (!st.converter) return false;
-  }
+  if (!gst_video_info_from_caps(&info, caps) || !st.converter.set_format(info)) return false;
   if (st.have_info && (GST_VIDEO_INFO_WIDTH(&info) != GST_VIDEO_INFO_WIDTH(&st.info) ||
                        GST_VIDEO_INFO_HEIGHT(&info) != GST_VIDEO_INFO_HEIGHT(&st.info))) {
     GST_INFO_OBJECT(self, "frame size changed: the stream of flows starts anew");
@@ -303,7 +251,7 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
   const auto started = std::chrono::steady_clock::now();
   std::optional<neuflow::flow::FlowField> flow;
   try {
-    flow = st.session->push(frame_view(st, frame));
+    flow = st.session->push(st.converter.view(frame));
   } catch (const std::exception &e) {
     gst_video_frame_unmap(&frame);
     gst_buffer_unref(buffer);
@@ -315,49 +263,18 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
 
   const GstClockTime pts = GST_BUFFER_PTS(buffer);
   if (flow) {
-    buffer = gst_buffer_make_writable(buffer);
-    GBytes *bytes = g_bytes_new(flow->uv.data(), flow->uv.size() * sizeof(float));
-    NeuflowFlowMeta *meta = neuflow_buffer_add_flow_meta(buffer, flow->width, flow->height, bytes);
-    g_bytes_unref(bytes);
-    meta->from_pts = st.previous_pts;
-    meta->to_pts = pts;
-    meta->from_frame = st.previous_frame;
-    meta->to_frame = frame_number;
-    const auto &opts = st.session->options();
-    const auto size = neuflow::model::model_size_for(flow->width, flow->height, opts);
-    meta->model_width = size.width;
-    meta->model_height = size.height;
-    meta->iters_s16 = opts.iterations.s16;
-    meta->iters_s8 = opts.iterations.s8;
-    meta->inference_time = static_cast<GstClockTime>(seconds * GST_SECOND);
+    buffer = neuflow::gst::attach_flow(buffer, *flow, {st.previous_pts, pts, st.previous_frame, frame_number},
+                                       st.session->options(), seconds);
   }
   st.previous_pts = pts;
   st.previous_frame = frame_number;
 
   bool post = false, announce = false;
-  Stats snapshot;
+  neuflow::gst::FlowStats snapshot;
   {
     const std::lock_guard lock(st.lock);
-    ++st.stats.processed;
-    if (flow) {
-      ++st.stats.flows;
-      st.stats.inference_seconds += seconds;
-      st.stats.last_inference_seconds = seconds;
-      // The latency we report follows recent inference times (the first flows pay for
-      // warm-up); the pipeline is told to ask again when the estimate first appears or moves
-      // by more than a fifth either way.
-      double& estimate = st.stats.latency_estimate;
-      estimate = estimate == 0 ? seconds : 0.75 * estimate + 0.25 * seconds;
-      const double announced = st.stats.announced_latency;
-      if (announced == 0 || std::abs(estimate - announced) > 0.2 * announced) {
-        st.stats.announced_latency = estimate;
-        announce = true;
-      }
-    }
-    const auto now = std::chrono::steady_clock::now();
-    if (settings.stats_interval > 0 &&
-        now - st.stats.last_message >= std::chrono::milliseconds(settings.stats_interval)) {
-      st.stats.last_message = now;
+    announce = st.stats.frame_out(flow.has_value(), seconds);
+    if (st.stats.message_due(std::chrono::steady_clock::now(), settings.stats_interval)) {
       snapshot = st.stats;
       post = true;
     }
@@ -493,17 +410,17 @@ GstFlowReturn sink_chain(GstPad * /*pad*/, GstObject *parent, GstBuffer *buffer)
   GstSegment segment{};
   if (*live) {
     const std::lock_guard lock(st.lock);
-    ++st.stats.frames_in;
+    st.stats.frame_in();
     item.frame = st.next_frame++;
     queued = st.input.push_frame(item, Handoff::Policy::newest_wins, &dropped);
-    st.stats.dropped += dropped.size();
-    processed = st.stats.processed;
-    drops = st.stats.dropped;
+    st.stats.dropped(dropped.size());
+    processed = st.stats.processed();
+    drops = st.stats.frames_dropped();
     segment = st.segment;
   } else {
     {
       const std::lock_guard lock(st.lock);
-      ++st.stats.frames_in;
+      st.stats.frame_in();
       item.frame = st.next_frame++;
     }
     queued = st.input.push_frame(item, Handoff::Policy::back_pressure);
@@ -607,7 +524,7 @@ gboolean src_query(GstPad *pad, GstObject *parent, GstQuery *query) {
   double per_frame = 0;
   {
     const std::lock_guard lock(st.lock);
-    per_frame = st.stats.announced_latency;
+    per_frame = st.stats.announced_latency();
   }
   // A frame waits at most for the one being computed, then for its own computation.
   const auto ours = static_cast<GstClockTime>(2 * per_frame * GST_SECOND);
@@ -674,8 +591,7 @@ GstStateChangeReturn change_state(GstElement *element, GstStateChange transition
         return GST_STATE_CHANGE_FAILURE;
       }
       const std::lock_guard lock(st.lock);
-      st.stats = Stats{};
-      st.stats.started = st.stats.last_message = std::chrono::steady_clock::now();
+      st.stats.restart(std::chrono::steady_clock::now());
       st.next_frame = 0;
       st.live.reset();
       st.have_info = false;
@@ -693,8 +609,6 @@ GstStateChangeReturn change_state(GstElement *element, GstStateChange transition
   switch (transition) {
     case GST_STATE_CHANGE_PAUSED_TO_READY:  // pads are deactivated: the worker has stopped
       st.session.reset();
-      if (st.converter) gst_video_converter_free(st.converter);
-      st.converter = nullptr;
       st.have_info = false;
       break;
     case GST_STATE_CHANGE_READY_TO_NULL:
@@ -731,19 +645,15 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
   if (id >= PROP_FRAMES_IN) {
     State &st = *self->state;
     const std::lock_guard lock(st.lock);
-    const Stats &s = st.stats;
-    const double elapsed =
-        s.processed ? std::chrono::duration<double>(std::chrono::steady_clock::now() - s.started).count() : 0.0;
+    const neuflow::gst::FlowStats &s = st.stats;
     switch (id) {
-      case PROP_FRAMES_IN: g_value_set_uint64(value, s.frames_in); break;
-      case PROP_FRAMES_PROCESSED: g_value_set_uint64(value, s.processed); break;
-      case PROP_FLOWS: g_value_set_uint64(value, s.flows); break;
-      case PROP_FRAMES_DROPPED: g_value_set_uint64(value, s.dropped); break;
-      case PROP_MEAN_LATENCY:
-        g_value_set_double(value, s.flows ? 1e3 * s.inference_seconds / static_cast<double>(s.flows) : 0.0);
-        break;
+      case PROP_FRAMES_IN: g_value_set_uint64(value, s.frames_in()); break;
+      case PROP_FRAMES_PROCESSED: g_value_set_uint64(value, s.processed()); break;
+      case PROP_FLOWS: g_value_set_uint64(value, s.flows()); break;
+      case PROP_FRAMES_DROPPED: g_value_set_uint64(value, s.frames_dropped()); break;
+      case PROP_MEAN_LATENCY: g_value_set_double(value, s.mean_latency_ms()); break;
       case PROP_PROCESSING_RATE:
-        g_value_set_double(value, elapsed > 0 ? static_cast<double>(s.processed) / elapsed : 0.0);
+        g_value_set_double(value, s.processing_rate(std::chrono::steady_clock::now()));
         break;
       default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
     }
@@ -771,7 +681,6 @@ void finalize(GObject *object) {
   flush_handoffs(*self->state);
   gst_object_unref(self->state->inference);
   g_rec_mutex_clear(&self->state->inference_lock);
-  if (self->state->converter) gst_video_converter_free(self->state->converter);
   delete self->state;
   delete self->model;
   delete self->settings;
