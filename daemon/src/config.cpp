@@ -43,6 +43,24 @@ std::string ConfigIssue::to_string() const {
   return text + (is_warning() ? ": warning: " : ": ") + message;
 }
 
+std::string ConfigIssue::source_excerpt() const {
+  if (line <= 0) return {};
+  std::ifstream in(file, std::ios::binary);
+  std::string text;
+  for (int n = 0; n < line && std::getline(in, text); ++n) {
+  }
+  if (!in && text.empty()) return {};
+  if (!text.empty() && text.back() == '\r') text.pop_back();
+  std::string excerpt = "    " + text;
+  if (column > 0) {
+    // Tabs stay tabs under the text so the caret lines up in any terminal.
+    std::string pad;
+    for (int i = 0; i + 1 < column && i < static_cast<int>(text.size()); ++i) pad += text[i] == '\t' ? '\t' : ' ';
+    excerpt += "\n    " + pad + "^";
+  }
+  return excerpt;
+}
+
 ConfigError::ConfigError(std::vector<ConfigIssue> issues)
     : std::runtime_error(summary(issues)), issues_(std::move(issues)) {}
 

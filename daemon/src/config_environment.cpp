@@ -42,7 +42,18 @@ std::string missing_or(int error) {
 
 void check_readable_file(const PathNeed& need, Issues& issues) {
   struct stat st {};
-  if (::stat(need.path.c_str(), &st) != 0) return report(need, issues, missing_or(errno));
+  if (::stat(need.path.c_str(), &st) != 0) {
+    const int error = errno;
+    if (need.key == "model" && error == ENOENT) {
+      const std::string fetch = "neuflow fetch-model mixed -o " + need.path.parent_path().string();
+      return report(need, issues,
+                    need.path.filename() == "neuflow_mixed.pth"
+                        ? "does not exist: download the published weights with `" + fetch + "`"
+                        : "does not exist: `" + fetch + "` downloads the published weights as neuflow_mixed.pth "
+                          "(point model at it), or copy a NeuFlow-V2 checkpoint here");
+    }
+    return report(need, issues, missing_or(error));
+  }
   if (S_ISDIR(st.st_mode)) return report(need, issues, "is a folder, expected a file");
   if (!S_ISREG(st.st_mode)) return report(need, issues, "is not a regular file");
   const int fd = ::open(need.path.c_str(), O_RDONLY | O_CLOEXEC);

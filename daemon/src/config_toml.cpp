@@ -24,6 +24,21 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
   return row[b.size()];
 }
 
+// The candidate a mistyped word most likely meant: within about a third of its length in
+// edits (at least 2), or nothing.
+std::string_view closest_match(std::string_view word, std::span<const std::string_view> candidates) {
+  std::string_view closest;
+  std::size_t best = std::max<std::size_t>(2, word.size() / 3) + 1;
+  for (const auto candidate : candidates) {
+    const std::size_t d = edit_distance(word, candidate);
+    if (d < best) {
+      best = d;
+      closest = candidate;
+    }
+  }
+  return closest;
+}
+
 std::string join(std::span<const std::string_view> words) {
   std::string out;
   for (const auto word : words) {
@@ -124,16 +139,9 @@ void TableReader::allow_only(std::span<const std::string_view> valid) const {
     const std::string_view name = key.str();
     if (std::find(valid.begin(), valid.end(), name) != valid.end()) continue;
     std::string message = "unknown key '" + std::string(name) + "' in " + what_;
-    std::string_view closest;
-    std::size_t best = std::max<std::size_t>(2, name.size() / 3) + 1;
-    for (const auto candidate : valid) {
-      const std::size_t d = edit_distance(name, candidate);
-      if (d < best) {
-        best = d;
-        closest = candidate;
-      }
+    if (const auto closest = closest_match(name, valid); !closest.empty()) {
+      message += " (did you mean '" + std::string(closest) + "'?)";
     }
-    if (!closest.empty()) message += " (did you mean '" + std::string(closest) + "'?)";
     message += "; valid keys: " + join(valid);
     issues_.add(position_of(key.source()), std::move(message));
   }
@@ -217,6 +225,9 @@ std::optional<std::string> TableReader::choice(std::string_view key, std::span<c
   }
   const auto* s = node->as_string();
   if (!s || std::find(values.begin(), values.end(), s->get()) == values.end()) {
+    std::string_view closest;
+    if (s) closest = closest_match(s->get(), values);
+    if (!closest.empty()) expected += " (did you mean \"" + std::string(closest) + "\"?)";
     wrong_value(key, *node, expected);
     return std::nullopt;
   }

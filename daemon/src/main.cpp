@@ -31,8 +31,14 @@ void keep_large_allocations_mapped() {
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
 }
 
+// One issue as compilers print theirs: the position and message, then the line with a caret.
+void print_issue(const neuflow::daemon::ConfigIssue& issue) {
+  std::fprintf(stderr, "%s\n", issue.to_string().c_str());
+  if (const std::string excerpt = issue.source_excerpt(); !excerpt.empty()) std::fprintf(stderr, "%s\n", excerpt.c_str());
+}
+
 void print_issues(const neuflow::daemon::ConfigError& e) {
-  for (const auto& issue : e.issues()) std::fprintf(stderr, "%s\n", issue.to_string().c_str());
+  for (const auto& issue : e.issues()) print_issue(issue);
 }
 
 }  // namespace
@@ -45,7 +51,7 @@ int main(int argc, char** argv) {
   std::string level;
   app.add_option("-c,--config", config_file, "Config file to run")->capture_default_str();
   app.add_option("--check-config", check_file,
-                 "Check FILE and exit: 78 with one line per error when the file itself is wrong (syntax, keys, "
+                 "Check FILE and exit: 78 with each error (its line, a caret under the column) when the file itself is wrong (syntax, keys, "
                  "types, ranges, names), else 0; what this machine lacks now (a camera, a model, an input file, a "
                  "GStreamer element) is printed as a warning, since the daemon waits for it");
   app.add_option("--log-level", level, "error, warning, notice, info or debug; overrides [daemon] log-level");
@@ -59,7 +65,7 @@ int main(int argc, char** argv) {
   if (!check_file.empty()) {
     try {
       const Config config = load_config(check_file);
-      for (const auto& warning : config.warnings) std::fprintf(stderr, "%s\n", warning.to_string().c_str());
+      for (const auto& warning : config.warnings) print_issue(warning);
       std::printf("%s: OK, %zu stream%s", check_file.c_str(), config.streams.size(),
                   config.streams.size() == 1 ? "" : "s");
       if (!config.warnings.empty()) {

@@ -37,8 +37,9 @@ ElementSpec leaky_queue(const std::string& name) {
       .set("max-size-time", "0");
 }
 
+// The colour image of the flow alone (the element's default blends it over the video).
 ElementSpec visualizer(const std::string& name, double max_flow) {
-  return element("neuflowviz", name).set("max-flow", std::to_string(max_flow));
+  return element("neuflowviz", name).set("mode", "flow").set("max-flow", std::to_string(max_flow));
 }
 
 // One H.264 setting for files, RTP/UDP and RTSP: live outputs trade compression for latency.

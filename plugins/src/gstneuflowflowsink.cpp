@@ -46,14 +46,27 @@ static void gst_neuflow_flow_sink_get_property(GObject *object, guint prop_id, G
   GST_OBJECT_UNLOCK(self);
 }
 
-static gboolean gst_neuflow_flow_sink_start(GstBaseSink *sink) {
-  GstNeuflowFlowSink *self = GST_NEUFLOW_FLOW_SINK(sink);
-  GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
-  GST_OBJECT_LOCK(self);
-  priv->flows_written = 0;
-  priv->buffers_skipped = 0;
-  GST_OBJECT_UNLOCK(self);
-  return GST_NEUFLOW_FLOW_SINK_GET_CLASS(self)->start_writing(self);
+// The subclass starts here rather than in GstBaseSink::start: when start() fails, GstBaseSink
+// posts a second, generic error ("state change failed and some element failed to post a
+// proper error message") after the subclass's own, and users saw both.
+static GstStateChangeReturn gst_neuflow_flow_sink_change_state(GstElement *element, GstStateChange transition) {
+  GstNeuflowFlowSink *self = GST_NEUFLOW_FLOW_SINK(element);
+  GstNeuflowFlowSinkClass *klass = GST_NEUFLOW_FLOW_SINK_GET_CLASS(self);
+  if (transition == GST_STATE_CHANGE_NULL_TO_READY) {
+    GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
+    GST_OBJECT_LOCK(self);
+    priv->flows_written = 0;
+    priv->buffers_skipped = 0;
+    GST_OBJECT_UNLOCK(self);
+    if (!klass->start_writing(self)) {
+      klass->stop_writing(self);
+      return GST_STATE_CHANGE_FAILURE;  // start_writing posted the error
+    }
+  }
+  const GstStateChangeReturn ret =
+      GST_ELEMENT_CLASS(gst_neuflow_flow_sink_parent_class)->change_state(element, transition);
+  if (ret == GST_STATE_CHANGE_FAILURE && transition == GST_STATE_CHANGE_NULL_TO_READY) klass->stop_writing(self);
+  return ret;
 }
 
 static gboolean gst_neuflow_flow_sink_stop(GstBaseSink *sink) {
@@ -122,7 +135,7 @@ static void gst_neuflow_flow_sink_class_init(GstNeuflowFlowSinkClass *klass) {
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
 
-  sink_class->start = GST_DEBUG_FUNCPTR(gst_neuflow_flow_sink_start);
+  element_class->change_state = GST_DEBUG_FUNCPTR(gst_neuflow_flow_sink_change_state);
   sink_class->stop = GST_DEBUG_FUNCPTR(gst_neuflow_flow_sink_stop);
   sink_class->render = GST_DEBUG_FUNCPTR(gst_neuflow_flow_sink_render);
   klass->written_noun = "flows";

@@ -18,8 +18,9 @@ G_DECLARE_DERIVABLE_TYPE(GstNeuflowFlowSink, gst_neuflow_flow_sink, GST, NEUFLOW
 struct _GstNeuflowFlowSinkClass {
   GstBaseSinkClass parent_class;
 
-  // Prepares to write (settings checked, outputs opened); posts an element error and returns
-  // FALSE when it cannot. Called after the counters are reset.
+  // Prepares to write (settings checked, outputs opened) when the element goes from NULL to
+  // READY, after the counters are reset; posts an element error and returns FALSE when it
+  // cannot (the only error the application then sees).
   gboolean (*start_writing)(GstNeuflowFlowSink *sink);
   // Writes one flow whose meta holds width × height × 2 floats; on failure posts an element
   // error and returns GST_FLOW_ERROR. Counted as written when it returns GST_FLOW_OK.

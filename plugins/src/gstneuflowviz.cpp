@@ -13,14 +13,17 @@
  * (by frame width / grid width and frame height / grid height) before colouring, so
  * #neuflowviz:max-flow is always in pixels of the frame being drawn on.
  *
- * In `flow` mode the frame is replaced by the flow image; in `overlay` mode the flow image
- * is blended over the video with #neuflowviz:alpha. #neuflowviz:arrows adds a grid of
- * arrows showing the displacement itself. Frames without a flow meta (the first frame of a
- * stream, frames the inference element dropped) pass through unchanged and uncopied.
+ * In `overlay` mode (the default) the flow image is blended over the video with
+ * #neuflowviz:alpha; in `flow` mode it replaces the frame. #neuflowviz:arrows adds a grid of
+ * anti-aliased arrows showing the displacement, scaled by #neuflowviz:arrow-scale (by default
+ * a vector of #neuflowviz:max-flow pixels is one #neuflowviz:arrow-spacing long). Frames
+ * without a flow meta (the first frame of a stream) pass through unchanged and uncopied in
+ * overlay mode, and are drawn as zero flow (white) in flow mode, as `neuflow convert` renders
+ * them.
  *
  * ## Example launch line
  * |[
- * gst-launch-1.0 v4l2src ! videoconvert ! neuflow ! videoconvert ! neuflowviz max-flow=30 mode=overlay alpha=0.6 arrows=true ! videoconvert ! autovideosink
+ * gst-launch-1.0 v4l2src ! videoconvert ! neuflow ! videoconvert ! neuflowviz max-flow=30 alpha=0.6 arrows=true ! videoconvert ! autovideosink
  * ]|
  */
 #include <gst/gst.h>
@@ -32,8 +35,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <exception>
+#include <limits>
 #include <optional>
 #include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "elements.hpp"
 #include "neuflow/flow/flow_field.hpp"
@@ -73,14 +80,17 @@ enum {
   PROP_ARROWS,
   PROP_ARROW_SPACING,
   PROP_ARROW_COLOR,
+  PROP_ARROW_SCALE,
 };
 
 #define DEFAULT_MAX_FLOW 20.0
-#define DEFAULT_MODE GST_NEUFLOW_VIZ_MODE_FLOW
+#define DEFAULT_MODE GST_NEUFLOW_VIZ_MODE_OVERLAY /* what a live view over the video wants */
 #define DEFAULT_ALPHA 0.6
 #define DEFAULT_ARROWS FALSE
 #define DEFAULT_ARROW_SPACING 24u
 #define DEFAULT_ARROW_COLOR 0xff000000u /* opaque black, 0xAARRGGBB */
+#define DEFAULT_ARROW_SCALE 0.0         /* auto: a vector of max-flow pixels is arrow-spacing long */
+#define MAX_ARROW_SCALE 1000.0
 
 #define MIN_ARROW_SPACING 4u
 #define MAX_ARROW_SPACING 4096u
@@ -95,6 +105,7 @@ struct VizSettings {
   gboolean arrows = DEFAULT_ARROWS;
   guint arrow_spacing = DEFAULT_ARROW_SPACING;
   guint arrow_color = DEFAULT_ARROW_COLOR;
+  gdouble arrow_scale = DEFAULT_ARROW_SCALE;
 };
 
 struct PixelLayout;
@@ -119,6 +130,7 @@ struct VizScratch {
   std::vector<int> x0, x1, wx;  // column -> grid columns and weight of x1 (0..256)
   std::vector<int> y0, y1, wy;  // the same for rows
   std::vector<int> row;          // one output row's blend of its two grid rows, RGB
+  cv::Mat arrow_mask;            // the arrows' anti-aliased coverage, 0..255
 };
 
 }  // namespace
@@ -225,115 +237,88 @@ void compose_flow(GstVideoFrame *frame, const PixelLayout &px, const neuflow::fl
   }
 }
 
-// Draws into one frame with a colour given as 0xAARRGGBB.
-class Painter {
- public:
-  Painter(GstVideoFrame *frame, const PixelLayout &px, guint argb)
-      : data_(static_cast<std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0))),
-        stride_(GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0)),
-        width_(GST_VIDEO_FRAME_WIDTH(frame)),
-        height_(GST_VIDEO_FRAME_HEIGHT(frame)),
-        px_(px),
-        r_(static_cast<int>((argb >> 16) & 0xff)),
-        g_(static_cast<int>((argb >> 8) & 0xff)),
-        b_(static_cast<int>(argb & 0xff)),
-        a_(static_cast<int>((argb >> 24) & 0xff)) {}
-
-  void dot(int x, int y) {
-    if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
-    std::uint8_t *p = data_ + static_cast<std::ptrdiff_t>(y) * stride_ + static_cast<std::ptrdiff_t>(x) * px_.stride;
-    p[px_.r] = mix(p[px_.r], r_);
-    p[px_.g] = mix(p[px_.g], g_);
-    p[px_.b] = mix(p[px_.b], b_);
-  }
-
-  // A one-pixel line, clipped to the frame first (Liang–Barsky) so that absurd vectors cost
-  // no more than the frame's diagonal.
-  void line(double xa, double ya, double xb, double yb) {
-    if (!clip(xa, ya, xb, yb)) return;
-    int x = static_cast<int>(std::lround(xa)), y = static_cast<int>(std::lround(ya));
-    const int x_end = static_cast<int>(std::lround(xb)), y_end = static_cast<int>(std::lround(yb));
-    const int dx = std::abs(x_end - x), dy = -std::abs(y_end - y);
-    const int step_x = x < x_end ? 1 : -1, step_y = y < y_end ? 1 : -1;
-    int err = dx + dy;
-    for (;;) {  // Bresenham
-      dot(x, y);
-      if (x == x_end && y == y_end) break;
-      const int e2 = 2 * err;
-      if (e2 >= dy) {
-        err += dy;
-        x += step_x;
-      }
-      if (e2 <= dx) {
-        err += dx;
-        y += step_y;
-      }
+// Clips the segment to [0, width-1] × [0, height-1] (Liang–Barsky), so that absurd vectors cost
+// no more than the frame's diagonal and fit OpenCV's integer coordinates; false when nothing
+// of it is inside.
+bool clip_segment(double &xa, double &ya, double &xb, double &yb, int width, int height) {
+  const double dx = xb - xa, dy = yb - ya;
+  double t0 = 0, t1 = 1;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {xa, (width - 1) - xa, ya, (height - 1) - ya};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0) {
+      if (q[i] < 0) return false;  // parallel to this edge and outside it
+      continue;
     }
-  }
-
-  // An arrow from (x, y) along (u, v), with a head scaled to its length and the grid spacing.
-  void arrow(double x, double y, double u, double v, double spacing) {
-    dot(static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)));
-    const double len = std::hypot(u, v);
-    if (!(len >= 1.0) || !std::isfinite(len)) return;  // under a pixel (or not finite): just the anchor
-    const double xe = x + u, ye = y + v;
-    line(x, y, xe, ye);
-    const double head = std::clamp(0.3 * len, 2.0, std::max(2.0, 0.4 * spacing));
-    const double angle = std::atan2(v, u);
-    constexpr double kSpread = 0.45;  // ~26 degrees either side of the shaft
-    line(xe, ye, xe - head * std::cos(angle - kSpread), ye - head * std::sin(angle - kSpread));
-    line(xe, ye, xe - head * std::cos(angle + kSpread), ye - head * std::sin(angle + kSpread));
-  }
-
- private:
-  std::uint8_t mix(int under, int over) const {
-    return static_cast<std::uint8_t>((under * (255 - a_) + over * a_ + 127) / 255);
-  }
-
-  bool clip(double &xa, double &ya, double &xb, double &yb) const {
-    const double dx = xb - xa, dy = yb - ya;
-    double t0 = 0, t1 = 1;
-    const double p[4] = {-dx, dx, -dy, dy};
-    const double q[4] = {xa, (width_ - 1) - xa, ya, (height_ - 1) - ya};
-    for (int i = 0; i < 4; ++i) {
-      if (p[i] == 0) {
-        if (q[i] < 0) return false;  // parallel to this edge and outside it
-        continue;
-      }
-      const double t = q[i] / p[i];
-      if (p[i] < 0) {
-        t0 = std::max(t0, t);
-      } else {
-        t1 = std::min(t1, t);
-      }
-      if (t0 > t1) return false;
+    const double t = q[i] / p[i];
+    if (p[i] < 0) {
+      t0 = std::max(t0, t);
+    } else {
+      t1 = std::min(t1, t);
     }
-    xb = xa + t1 * dx;
-    yb = ya + t1 * dy;
-    xa = xa + t0 * dx;
-    ya = ya + t0 * dy;
-    return true;
+    if (t0 > t1) return false;
   }
+  xb = xa + t1 * dx;
+  yb = ya + t1 * dy;
+  xa = xa + t0 * dx;
+  ya = ya + t0 * dy;
+  return true;
+}
 
-  std::uint8_t *data_;
-  int stride_, width_, height_;
-  PixelLayout px_;
-  int r_, g_, b_, a_;
-};
+// OpenCV's fixed-point coordinates: sub-pixel positions for anti-aliased lines.
+constexpr int kShift = 4;
+cv::Point fixed_point(double x, double y) {
+  return {static_cast<int>(std::lround(x * (1 << kShift))), static_cast<int>(std::lround(y * (1 << kShift)))};
+}
 
-// One arrow at the centre of each spacing × spacing cell, showing the vector of the grid
-// cell under it (nearest), in frame pixels.
+// One anti-aliased arrow at the centre of each spacing × spacing cell, showing the vector of the
+// grid cell under it (nearest) in frame pixels times `scale`, at most `max_length` long,
+// blended in the colour 0xAARRGGBB.
 void draw_arrows(GstVideoFrame *frame, const PixelLayout &px, const neuflow::flow::FlowField &field, guint spacing,
-                 guint argb) {
+                 double scale, double max_length, guint argb, cv::Mat &mask) {
   const int fw = GST_VIDEO_FRAME_WIDTH(frame);
   const int fh = GST_VIDEO_FRAME_HEIGHT(frame);
   const int step = static_cast<int>(spacing);
-  Painter painter(frame, px, argb);
+  mask.create(fh, fw, CV_8UC1);
+  mask.setTo(0);
   for (int y = step / 2; y < fh; y += step) {
     const int gy = std::min(static_cast<int>((y + 0.5) * field.height / fh), field.height - 1);
     for (int x = step / 2; x < fw; x += step) {
       const int gx = std::min(static_cast<int>((x + 0.5) * field.width / fw), field.width - 1);
-      painter.arrow(x, y, field.u(gx, gy), field.v(gx, gy), step);
+      double u = scale * field.u(gx, gy), v = scale * field.v(gx, gy);
+      const double len = std::hypot(u, v);
+      if (!(len >= 1.0) || !std::isfinite(len)) {  // under a pixel (or not finite): just the anchor
+        mask.at<std::uint8_t>(y, x) = 255;
+        continue;
+      }
+      if (len > max_length) {
+        u *= max_length / len;
+        v *= max_length / len;
+      }
+      double xa = x, ya = y, xb = x + u, yb = y + v;
+      if (!clip_segment(xa, ya, xb, yb, fw, fh)) continue;
+      // The head: a fixed share of the drawn length, at least 2 px, at most 0.4 of the spacing.
+      const double drawn = std::hypot(xb - xa, yb - ya);
+      const double head = std::clamp(0.3 * drawn, 2.0, std::max(2.0, 0.4 * step));
+      cv::arrowedLine(mask, fixed_point(xa, ya), fixed_point(xb, yb), cv::Scalar(255), 1, cv::LINE_AA, kShift,
+                      drawn > 0 ? std::min(1.0, head / drawn) : 0.0);
+    }
+  }
+  const int a = static_cast<int>((argb >> 24) & 0xff);
+  const int color[3] = {static_cast<int>((argb >> 16) & 0xff), static_cast<int>((argb >> 8) & 0xff),
+                        static_cast<int>(argb & 0xff)};
+  auto *data = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0));
+  const int stride = GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0);
+  for (int y = 0; y < fh; ++y) {
+    const std::uint8_t *m = mask.ptr<std::uint8_t>(y);
+    std::uint8_t *p = data + static_cast<std::ptrdiff_t>(y) * stride;
+    for (int x = 0; x < fw; ++x, p += px.stride) {
+      if (m[x] == 0) continue;
+      const int w = (m[x] * a + 127) / 255;  // coverage × opacity
+      const int offsets[3] = {px.r, px.g, px.b};
+      for (int c = 0; c < 3; ++c) {
+        p[offsets[c]] = static_cast<std::uint8_t>((p[offsets[c]] * (255 - w) + color[c] * w + 127) / 255);
+      }
     }
   }
 }
@@ -361,6 +346,9 @@ static void gst_neuflow_viz_set_property(GObject *object, guint prop_id, const G
       break;
     case PROP_ARROW_COLOR:
       self->settings.arrow_color = g_value_get_uint(value);
+      break;
+    case PROP_ARROW_SCALE:
+      self->settings.arrow_scale = g_value_get_double(value);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -390,6 +378,9 @@ static void gst_neuflow_viz_get_property(GObject *object, guint prop_id, GValue 
       break;
     case PROP_ARROW_COLOR:
       g_value_set_uint(value, self->settings.arrow_color);
+      break;
+    case PROP_ARROW_SCALE:
+      g_value_set_double(value, self->settings.arrow_scale);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -435,24 +426,41 @@ static gboolean gst_neuflow_viz_set_info(GstVideoFilter *filter, GstCaps * /*inc
   return TRUE;
 }
 
-// Frames without flow go through untouched: passthrough avoids copying a non-writable buffer
-// that would not be modified anyway.
+// In overlay mode, frames without flow go through untouched: passthrough avoids copying a
+// non-writable buffer that would not be modified anyway. In flow mode they are drawn as zero
+// flow (white), so a rendering does not flash the camera picture at its start.
 static void gst_neuflow_viz_before_transform(GstBaseTransform *trans, GstBuffer *buffer) {
-  const bool has_flow = neuflow_buffer_get_flow_meta(buffer) != nullptr;
-  if ((gst_base_transform_is_passthrough(trans) != FALSE) == has_flow) {
-    GST_LOG_OBJECT(trans, "%s", has_flow ? "flow meta present: drawing" : "no flow meta: passing through");
-    gst_base_transform_set_passthrough(trans, !has_flow);
+  GstNeuflowViz *self = GST_NEUFLOW_VIZ(trans);
+  GST_OBJECT_LOCK(self);
+  const bool flow_mode = self->settings.mode == GST_NEUFLOW_VIZ_MODE_FLOW;
+  GST_OBJECT_UNLOCK(self);
+  const bool draw = flow_mode || neuflow_buffer_get_flow_meta(buffer) != nullptr;
+  if ((gst_base_transform_is_passthrough(trans) != FALSE) == draw) {
+    GST_LOG_OBJECT(trans, "%s", draw ? "drawing" : "no flow meta: passing through");
+    gst_base_transform_set_passthrough(trans, !draw);
+  }
+}
+
+// Every pixel white (zero flow in the Middlebury convention); alpha and padding bytes kept.
+static void fill_zero_flow(GstVideoFrame *frame, const PixelLayout &px) {
+  auto *data = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0));
+  const int stride = GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0);
+  for (int y = 0; y < GST_VIDEO_FRAME_HEIGHT(frame); ++y) {
+    std::uint8_t *p = data + static_cast<std::ptrdiff_t>(y) * stride;
+    for (int x = 0; x < GST_VIDEO_FRAME_WIDTH(frame); ++x, p += px.stride) p[px.r] = p[px.g] = p[px.b] = 255;
   }
 }
 
 static GstFlowReturn gst_neuflow_viz_transform_frame_ip(GstVideoFilter *filter, GstVideoFrame *frame) {
   GstNeuflowViz *self = GST_NEUFLOW_VIZ(filter);
   NeuflowFlowMeta *meta = neuflow_buffer_get_flow_meta(frame->buffer);
-  if (!meta || meta->width == 0 || meta->height == 0) return GST_FLOW_OK;
-
   GST_OBJECT_LOCK(self);
   const VizSettings settings = self->settings;
   GST_OBJECT_UNLOCK(self);
+  if (!meta || meta->width == 0 || meta->height == 0) {
+    if (settings.mode == GST_NEUFLOW_VIZ_MODE_FLOW) fill_zero_flow(frame, self->layout);
+    return GST_FLOW_OK;
+  }
 
   const int fw = GST_VIDEO_FRAME_WIDTH(frame);
   const int fh = GST_VIDEO_FRAME_HEIGHT(frame);
@@ -487,7 +495,15 @@ static GstFlowReturn gst_neuflow_viz_transform_frame_ip(GstVideoFilter *filter, 
     } else if (weight > 0) {
       self->layout.overlay(frame, self->layout, vis.image, s, weight);
     }
-    if (settings.arrows) draw_arrows(frame, self->layout, s.field, settings.arrow_spacing, settings.arrow_color);
+    if (settings.arrows) {
+      // Auto scale: a vector of max-flow pixels (this frame's largest when max-flow is 0) is
+      // one arrow-spacing long, and longer ones are drawn that long, so arrows stay in their cell.
+      const bool automatic = settings.arrow_scale <= 0;
+      const double spacing = settings.arrow_spacing;
+      const double scale = automatic ? spacing / std::max(vis.max_flow, 1e-6) : settings.arrow_scale;
+      draw_arrows(frame, self->layout, s.field, settings.arrow_spacing, scale,
+                  automatic ? spacing : std::numeric_limits<double>::infinity(), settings.arrow_color, s.arrow_mask);
+    }
   } catch (const std::exception &e) {
     GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Could not draw the optical flow: %s", e.what()), (nullptr));
     return GST_FLOW_ERROR;
@@ -528,8 +544,8 @@ static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
   g_object_class_install_property(
       gobject_class, PROP_ARROWS,
       g_param_spec_boolean("arrows", "Arrows",
-                           "Draw a grid of arrows, one per arrow-spacing pixels, each showing the displacement "
-                           "(in frame pixels, true length) at its starting point",
+                           "Draw a grid of anti-aliased arrows, one per arrow-spacing pixels, each showing the "
+                           "displacement at its starting point, scaled by arrow-scale",
                            DEFAULT_ARROWS, rw));
   g_object_class_install_property(
       gobject_class, PROP_ARROW_SPACING,
@@ -540,6 +556,13 @@ static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
       g_param_spec_uint("arrow-color", "Arrow colour",
                         "Colour of the arrows as 0xAARRGGBB (AA = opacity; default opaque black)", 0, G_MAXUINT32,
                         DEFAULT_ARROW_COLOR, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_ARROW_SCALE,
+      g_param_spec_double("arrow-scale", "Arrow scale",
+                          "Arrow length per pixel of displacement (1: true length). 0: automatic, a vector of "
+                          "max-flow pixels is drawn arrow-spacing long and longer ones no longer, so arrows stay "
+                          "within their cell",
+                          0.0, MAX_ARROW_SCALE, DEFAULT_ARROW_SCALE, rw));
 
   gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow visualization",
                                         "Filter/Effect/Video/Analyzer",

@@ -294,7 +294,10 @@ class DaemonLifecycle(DaemonTestCase):
         d.notify.wait_for("READY=1", timeout=60)
         d.notify.wait_for("WATCHDOG=1", timeout=10)
         d.notify.wait_for("WATCHDOG=1", timeout=10)
-        status = d.notify.wait_for("STATUS=w ", timeout=30)
+        # STATUS= is sent when it changes: it may have come with READY=1 and not since (a stream
+        # that keeps up with its source holds one rate), so earlier messages count too.
+        status = next((m for m in d.notify.seen if m.startswith("STATUS=w ")), None) or \
+            d.notify.wait_for("STATUS=w ", timeout=30)
         self.assertRegex(status, r"STATUS=w (\d+\.\d fps|playing|starting)")
         self.assertEqual(d.stop(), 0)
 
@@ -464,6 +467,14 @@ class CheckConfig(DaemonTestCase):
         self.assertEqual(out.returncode, 78, out.stderr)
         line = next(i for i, l in enumerate(text.splitlines(), 1) if "colour" in l)
         self.assertRegex(out.stderr, re.escape(path) + f":{line}:\\d+: .*colour")
+        # The offending line follows, with a caret under the key.
+        self.assertRegex(out.stderr, r'\n    +colour = "red"\n +\^\n')
+
+    def test_unknown_choice_offers_the_closest_value(self):
+        text = stream_block("typo", test_source(), ['  type = "fiels"\n  directory = "%s"' % os.path.join(self.dir, "x")])
+        out, _ = self.run_check(text)
+        self.assertEqual(out.returncode, 78, out.stderr)
+        self.assertIn('(did you mean "files"?)', out.stderr)
 
     def test_missing_model_is_a_warning_and_the_stream_waits_for_it(self):
         model = os.path.join(self.dir, "models", "late.pth")

@@ -66,9 +66,9 @@ PY
 if "$neuflow" flow --help | grep -q -- "--size"; then fail "help must not list the hidden --size"; fi
 "$neuflow" flow -m "$fixture/checkpoint.pth" --model-width 100 --model-height 64 \
   "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo" 2>"$out/err"
-[ $? -eq 1 ] || fail "a model width that is not a multiple of 16 must fail"
+[ $? -eq 64 ] || fail "a model width that is not a multiple of 16 is a usage error (64)"
 grep -q "model-width: expected a multiple of 16" "$out/err" || fail "unclear model-width error: $(cat "$out/err")"
 "$neuflow" flow -m "$fixture/checkpoint.pth" --size 160 "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo" \
   2>"$out/err"
-[ $? -eq 1 ] && grep -q "WIDTHxHEIGHT" "$out/err" || fail "--size without a height must say WIDTHxHEIGHT"
+[ $? -eq 64 ] && grep -q "WIDTHxHEIGHT" "$out/err" || fail "--size without a height must say WIDTHxHEIGHT"
 echo "all flow command checks passed"

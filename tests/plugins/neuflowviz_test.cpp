@@ -17,8 +17,10 @@ namespace {
 using flow::flow_color;
 using flow::Rgb8;
 
-HarnessPtr make_viz(GstVideoFormat format, int width, int height) {
+// Most tests look at the flow image alone (mode=flow); the default blends it over the video.
+HarnessPtr make_viz(GstVideoFormat format, int width, int height, const char *mode = "flow") {
   HarnessPtr h(gst_harness_new("neuflowviz"));
+  gst_util_set_object_arg(G_OBJECT(h->element), "mode", mode);
   gst_harness_set_src_caps_str(h.get(), caps_string(format, width, height).c_str());
   return h;
 }
@@ -59,21 +61,22 @@ void expect_uniform(GstBuffer *buffer, int width, int height, const Rgb8 &expect
 TEST(NeuflowViz, PropertiesHaveTheirDocumentedDefaults) {
   ElementPtr viz = owned(gst_element_factory_make("neuflowviz", nullptr));
   ASSERT_TRUE(viz) << "neuflowviz not found: is GST_PLUGIN_PATH the build directory?";
-  gdouble max_flow = 0, alpha = 0;
+  gdouble max_flow = 0, alpha = 0, scale = -1;
   gboolean arrows = TRUE;
   guint spacing = 0, color = 0;
   gint mode = -1;
   g_object_get(viz.get(), "max-flow", &max_flow, "alpha", &alpha, "arrows", &arrows, "arrow-spacing", &spacing,
-               "arrow-color", &color, "mode", &mode, nullptr);
+               "arrow-color", &color, "mode", &mode, "arrow-scale", &scale, nullptr);
   EXPECT_EQ(max_flow, 20.0);
   EXPECT_EQ(alpha, 0.6);
   EXPECT_FALSE(arrows);
   EXPECT_EQ(spacing, 24u);
   EXPECT_EQ(color, 0xff000000u);
-  EXPECT_EQ(mode, 1);  // flow
-  gst_util_set_object_arg(G_OBJECT(viz.get()), "mode", "overlay");
+  EXPECT_EQ(scale, 0.0);  // automatic
+  EXPECT_EQ(mode, 0);  // overlay: what the README's live view expects
+  gst_util_set_object_arg(G_OBJECT(viz.get()), "mode", "flow");
   g_object_get(viz.get(), "mode", &mode, nullptr);
-  EXPECT_EQ(mode, 0);
+  EXPECT_EQ(mode, 1);
 }
 
 TEST(NeuflowViz, ZeroFlowIsWhiteInFlowMode) {
@@ -142,9 +145,9 @@ TEST(NeuflowViz, OtherDirectionsGetTheirWheelColours) {
   }
 }
 
-TEST(NeuflowViz, FrameWithoutFlowPassesThroughUnchangedAndUncopied) {
+TEST(NeuflowViz, FrameWithoutFlowPassesThroughUnchangedAndUncopiedInOverlayMode) {
   constexpr int w = 8, h = 6;
-  auto harness = make_viz(GST_VIDEO_FORMAT_BGRx, w, h);
+  auto harness = make_viz(GST_VIDEO_FORMAT_BGRx, w, h, "overlay");
   for (int round = 0; round < 2; ++round) {
     // A buffer someone else also holds is not writable: an in-place transform would copy it.
     GstBuffer *in = make_frame(GST_VIDEO_FORMAT_BGRx, w, h, 77);
@@ -161,7 +164,24 @@ TEST(NeuflowViz, FrameWithoutFlowPassesThroughUnchangedAndUncopied) {
     BufferPtr drawn(gst_harness_push_and_pull(harness.get(),
                                               frame_with_uniform_flow(GST_VIDEO_FORMAT_BGRx, w, h, 77, w, h, 0, 0)));
     ASSERT_TRUE(drawn);
-    EXPECT_EQ(pixel_bytes(drawn.get(), GST_VIDEO_FORMAT_BGRx, w, h, 3, 3), (std::vector<std::uint8_t>{255, 255, 255, 77}));
+    EXPECT_NE(pixel_bytes(drawn.get(), GST_VIDEO_FORMAT_BGRx, w, h, 3, 3), (std::vector<std::uint8_t>(4, 77)));
+  }
+}
+
+// The first frame of a stream has no flow yet: in flow mode it leaves as the zero-flow
+// rendering (white), not as the camera picture, so a rendering never flashes the video.
+TEST(NeuflowViz, FrameWithoutFlowIsZeroFlowWhiteInFlowMode) {
+  constexpr int w = 8, h = 6;
+  auto harness = make_viz(GST_VIDEO_FORMAT_RGBA, w, h, "flow");
+  GstBuffer *in = make_frame(GST_VIDEO_FORMAT_RGBA, w, h, 77);
+  BufferPtr keep(gst_buffer_ref(in));  // not writable: the element must draw on a copy
+  BufferPtr out(gst_harness_push_and_pull(harness.get(), in));
+  ASSERT_TRUE(out);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      ASSERT_EQ(pixel_bytes(out.get(), GST_VIDEO_FORMAT_RGBA, w, h, x, y), (std::vector<std::uint8_t>{255, 255, 255, 77}));
+      ASSERT_EQ(pixel_bytes(keep.get(), GST_VIDEO_FORMAT_RGBA, w, h, x, y), (std::vector<std::uint8_t>(4, 77)));
+    }
   }
 }
 
@@ -225,44 +245,91 @@ TEST(NeuflowViz, MaxFlowZeroNormalizesEachFrameByItsLargestVector) {
   expect_uniform(still.get(), w, h, Rgb8{255, 255, 255});
 }
 
-TEST(NeuflowViz, ArrowsStartAtTheGridPointsAndShowTheDisplacement) {
+// How far a pixel is from the flow colour underneath, 0 (untouched) to 255 (black on white).
+int darkening(GstBuffer *out, int w, int h, int x, int y, const Rgb8 &background) {
+  const Rgb8 got = rgb_at(out, GST_VIDEO_FORMAT_RGB, w, h, x, y);
+  int most = 0;
+  for (std::size_t c = 0; c < 3; ++c) most = std::max(most, std::abs(static_cast<int>(background[c]) - got[c]));
+  return most;
+}
+
+TEST(NeuflowViz, ArrowsStartAtTheGridPointsAndShowTheScaledDisplacement) {
   constexpr int w = 32, h = 32;
   auto harness = make_viz(GST_VIDEO_FORMAT_RGB, w, h);
-  g_object_set(harness->element, "arrows", TRUE, "arrow-spacing", 16u, nullptr);
+  g_object_set(harness->element, "arrows", TRUE, "arrow-spacing", 16u, "arrow-scale", 1.0, nullptr);
+  const Rgb8 background = flow_color(6.0 / 20.0, 0);
   BufferPtr out(
       gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 6, 0)));
   ASSERT_TRUE(out);
-  const Rgb8 black{0, 0, 0}, background = flow_color(6.0 / 20.0, 0);
-  // Arrows start at the cell centres (8, 8), (24, 8), (8, 24), (24, 24) and run 6 px right.
+  // At true length (arrow-scale 1) the arrows start at the cell centres (8, 8), (24, 8),
+  // (8, 24), (24, 24) and run 6 px right; the anti-aliased shaft covers its pixels.
   for (int ay : {8, 24}) {
     for (int ax : {8, 24}) {
-      for (int x = ax; x <= ax + 6; ++x) EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, x, ay), black);
-      EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, ax - 1, ay), background);  // nothing behind the start
+      for (int x = ax; x <= ax + 6; ++x) EXPECT_GT(darkening(out.get(), w, h, x, ay, background), 100) << x << "," << ay;
+      EXPECT_EQ(darkening(out.get(), w, h, ax - 2, ay, background), 0);  // nothing behind the start
       if (ax + 8 < w) {
-        EXPECT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, ax + 8, ay), background);  // nothing past the tip
+        EXPECT_EQ(darkening(out.get(), w, h, ax + 8, ay, background), 0);  // nothing past the tip
       }
     }
   }
   // Everything else is within the arrow heads' reach of the shafts.
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const bool near_shaft = (std::abs(y - 8) <= 3 || std::abs(y - 24) <= 3);
-      if (!near_shaft) {
-        ASSERT_EQ(rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, x, y), background) << x << "," << y;
+      if (std::abs(y - 8) > 3 && std::abs(y - 24) > 3) {
+        ASSERT_EQ(darkening(out.get(), w, h, x, y, background), 0) << x << "," << y;
       }
     }
   }
+  // Lines are anti-aliased: the heads' diagonals leave partly covered pixels.
+  bool partial = false;
+  for (int y = 4; y <= 12 && !partial; ++y) {
+    for (int x = 8; x <= 16 && !partial; ++x) {
+      const int d = darkening(out.get(), w, h, x, y, background);
+      partial = d > 0 && d < 200;
+    }
+  }
+  EXPECT_TRUE(partial) << "no partly covered pixel: the arrows are not anti-aliased";
+
+  // Automatic scale: a vector of max-flow (20 px) is one spacing (16 px) long, so this one is
+  // 6 * 16 / 20 = 4.8 px and the tip stops short of where the true-length arrow ended.
+  g_object_set(harness->element, "arrow-scale", 0.0, nullptr);
+  BufferPtr scaled(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 6, 0)));
+  ASSERT_TRUE(scaled);
+  EXPECT_GT(darkening(scaled.get(), w, h, 12, 8, background), 100);
+  EXPECT_EQ(darkening(scaled.get(), w, h, 15, 8, background), 0);
+  // A vector far beyond max-flow is drawn one spacing long instead of crossing the frame:
+  // compared with the same frame drawn without arrows, nothing changes past the next anchor.
+  const auto one_huge_vector = [] {
+    GstBuffer *in = make_frame(GST_VIDEO_FORMAT_RGB, 48, 16, 0);
+    add_flow(in, 3, 1, make_vectors(3, 1, [](int x, int) { return x == 0 ? std::pair{100.f, 0.f} : std::pair{0.f, 0.f}; }),
+             48, 16);
+    return in;
+  };
+  auto wide = make_viz(GST_VIDEO_FORMAT_RGB, 48, 16);
+  BufferPtr plain(gst_harness_push_and_pull(wide.get(), one_huge_vector()));
+  g_object_set(wide->element, "arrows", TRUE, "arrow-spacing", 16u, nullptr);
+  BufferPtr with_arrow(gst_harness_push_and_pull(wide.get(), one_huge_vector()));
+  ASSERT_TRUE(plain && with_arrow);
+  EXPECT_NE(rgb_at(with_arrow.get(), GST_VIDEO_FORMAT_RGB, 48, 16, 20, 8), rgb_at(plain.get(), GST_VIDEO_FORMAT_RGB, 48, 16, 20, 8));
+  for (int x = 28; x < 48; ++x) {
+    if (x == 40) continue;  // the third cell's anchor
+    EXPECT_EQ(rgb_at(with_arrow.get(), GST_VIDEO_FORMAT_RGB, 48, 16, x, 8), rgb_at(plain.get(), GST_VIDEO_FORMAT_RGB, 48, 16, x, 8))
+        << "x " << x;
+  }
 
   // A translucent white: blended with the flow colour underneath.
-  g_object_set(harness->element, "arrow-color", 0x80ffffffu, nullptr);
+  g_object_set(harness->element, "arrow-scale", 1.0, "arrow-color", 0x80ffffffu, nullptr);
   BufferPtr translucent(
       gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, w, h, 6, 0)));
   ASSERT_TRUE(translucent);
-  Rgb8 expected{};
+  // On the shaft (nearly full coverage) the pixel is about half way to white.
+  const Rgb8 got = rgb_at(translucent.get(), GST_VIDEO_FORMAT_RGB, w, h, 10, 8);
   for (std::size_t c = 0; c < 3; ++c) {
-    expected[c] = static_cast<std::uint8_t>((background[c] * (255 - 128) + 255 * 128 + 127) / 255);
+    const int half = (background[c] * (255 - 128) + 255 * 128 + 127) / 255;
+    EXPECT_LE(got[c], half) << "channel " << c;
+    EXPECT_GE(got[c], background[c] + (half - background[c]) * 8 / 10) << "channel " << c;
   }
-  EXPECT_EQ(rgb_at(translucent.get(), GST_VIDEO_FORMAT_RGB, w, h, 10, 8), expected);
 }
 
 TEST(NeuflowViz, HugeAndNonFiniteVectorsAreClippedNotFatal) {
@@ -298,7 +365,7 @@ TEST(NeuflowViz, NegotiatesThroughVideoconvert) {
 
 TEST(NeuflowViz, FlowMetaSurvivesVideoconvertInFront) {
   constexpr int w = 8, h = 6;
-  HarnessPtr harness(gst_harness_new_parse("videoconvert ! video/x-raw,format=RGBA ! neuflowviz"));
+  HarnessPtr harness(gst_harness_new_parse("videoconvert ! video/x-raw,format=RGBA ! neuflowviz mode=flow"));
   gst_harness_set_src_caps_str(harness.get(), caps_string(GST_VIDEO_FORMAT_I420, w, h).c_str());
   BufferPtr out(gst_harness_push_and_pull(harness.get(),
                                           frame_with_uniform_flow(GST_VIDEO_FORMAT_I420, w, h, 128, w, h, 20, 0)));

@@ -2,6 +2,7 @@
 // Helpers for the sink tests (neuflowshmsink, neuflowsink retention): sinks started under a
 // GstHarness with an error bus, and buffers carrying a synthetic flow with full metadata.
 #include <gst/gst.h>
+#include <gtest/gtest.h>
 
 #include <string>
 #include <utility>
@@ -42,7 +43,7 @@ inline RunningSink start_sink(const char *factory, const Properties &properties)
   return s;
 }
 
-// Starting `factory` (READY -> PAUSED) fails with an error whose message is returned.
+// Starting `factory` (READY -> PAUSED) fails with one error, whose message is returned.
 inline ErrorMessage start_error(const char *factory, const Properties &properties) {
   ElementPtr element = make_element(factory, properties);
   if (!element) return {};
@@ -50,6 +51,9 @@ inline ErrorMessage start_error(const char *factory, const Properties &propertie
   gst_element_set_bus(element.get(), bus.get());
   const GstStateChangeReturn ret = gst_element_set_state(element.get(), GST_STATE_PAUSED);
   ErrorMessage error = pop_error(bus.get());
+  // Reported once: no generic "state change failed" error from GstBaseSink after ours.
+  const ErrorMessage second = pop_error(bus.get());
+  EXPECT_FALSE(second.found) << factory << " posted a second error: " << second.message;
   gst_element_set_state(element.get(), GST_STATE_NULL);
   if (ret != GST_STATE_CHANGE_FAILURE) error.found = false;
   return error;

@@ -69,7 +69,7 @@ std::string summary_line(const InputSpec& input, const InputOutcome& outcome) {
 
 void run_convert(const ConvertArgs& a) {
   const model::SessionOptions options = session_options(a.session);
-  if (a.inputs.empty() && a.pairs.empty()) throw CommandError(kExitFailure, "nothing to convert: give INPUT... or --pair A B");
+  if (a.inputs.empty() && a.pairs.empty()) throw CommandError(kExitUsage, "nothing to convert: give INPUT... or --pair A B");
 
   std::shared_ptr<const model::FlowModel> model;
   try {

@@ -121,7 +121,7 @@ void write_json(const std::string& path, const std::string& text) {
 
 void run(const EvalArgs& a) {
   const auto dataset = eval::parse_dataset(a.dataset);
-  if (!dataset) throw CommandError(kExitFailure, "eval: unknown dataset '" + a.dataset + "'");
+  if (!dataset) throw CommandError(kExitUsage, "eval: unknown dataset '" + a.dataset + "'");
   eval::LayoutOptions layout;
   layout.sintel_pass = a.pass == "clean" ? eval::SintelPass::clean
                        : a.pass == "final" ? eval::SintelPass::final

@@ -43,7 +43,7 @@ int fetch_exit_code(const FetchError& e) {
 
 void run_fetch_model(const FetchModelArgs& a) {
   const PublishedModel* model = find_published_model(a.name);
-  if (!model) throw CommandError(kExitFailure, "fetch-model: unknown model '" + a.name + "'");
+  if (!model) throw CommandError(kExitUsage, "fetch-model: unknown model '" + a.name + "'");
 
   FetchRequest request;
   request.url = model_url(a.base_url, model->file);

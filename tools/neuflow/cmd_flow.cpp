@@ -43,7 +43,7 @@ std::shared_ptr<const model::FlowModel> load_model(const std::string& path) {
 
 void run_flow(const FlowArgs& a) {
   if (!flow::flow_format_from_path(a.output)) {
-    throw CommandError(kExitFailure, a.output + ": the output's extension must be .flo, .npy or .png");
+    throw CommandError(kExitUsage, a.output + ": the output's extension must be .flo, .npy or .png");
   }
   const model::SessionOptions options = session_options(a.session);
   const cv::Mat img0 = read_image(a.image0), img1 = read_image(a.image1);

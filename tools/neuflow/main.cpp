@@ -6,6 +6,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "common/usage_errors.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"neuflow: NeuFlow-V2 optical flow on the CPU"};
@@ -20,10 +21,11 @@ int main(int argc, char** argv) {
   neuflow::cli::register_eval(app);
   neuflow::cli::register_fetch_model(app);
 
+  if (argc <= 1) return neuflow::cli::report_no_arguments(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return neuflow::cli::report_parse_error(app, e, argc, argv);
   } catch (const neuflow::cli::CommandError& e) {
     std::fprintf(stderr, "neuflow: %s\n", e.what());
     return e.exit_code;

@@ -46,12 +46,12 @@ model::SessionOptions session_options(const SessionArgs& args) {
   if (!args.size_alias.empty()) {
     char rest = 0;
     if (std::sscanf(args.size_alias.c_str(), "%dx%d%c", &options.model_width, &options.model_height, &rest) != 2) {
-      throw CommandError(kExitFailure, "--size wants WIDTHxHEIGHT (multiples of 16), got '" + args.size_alias + "'");
+      throw CommandError(kExitUsage, "--size wants WIDTHxHEIGHT (multiples of 16), got '" + args.size_alias + "'");
     }
   }
   options.network_order = args.bgr_alias ? model::ChannelOrder::bgr
                                          : model::parse_channel_order(args.channel_order).value_or(model::ChannelOrder::rgb);
-  if (auto problem = model::check_session_options(options)) throw CommandError(kExitFailure, "--" + *problem);
+  if (auto problem = model::check_session_options(options)) throw CommandError(kExitUsage, "--" + *problem);
   return options;
 }
 

@@ -24,7 +24,7 @@ enum class ModelSizeOptions { offered, not_offered };
 // Registers the options on `command`; `args` must outlive the parse.
 void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions model_size = ModelSizeOptions::offered);
 
-// The parsed options, checked as the session checks them. Throws CommandError (kExitFailure)
+// The parsed options, checked as the session checks them. Throws CommandError (kExitUsage)
 // naming the option and what it expected.
 model::SessionOptions session_options(const SessionArgs& args);
 

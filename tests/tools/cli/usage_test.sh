@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Usage errors of `neuflow`: exit 64 (EX_USAGE) with CLI11's message, an unknown option named
+# before a missing required one, the help (exit 64) when no arguments are given.
+# Usage: usage_test.sh NEUFLOW_BIN
+set -u
+neuflow=$1
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+fail() { echo "FAIL: $*"; echo "--- stderr:"; cat "$out/err"; exit 1; }
+
+expect() {  # expect CODE PATTERN ARGS...: exit CODE and PATTERN (grep -E) on stderr
+  local want=$1 pattern=$2
+  shift 2
+  "$neuflow" "$@" >"$out/out" 2>"$out/err"
+  local got=$?
+  [ "$got" -eq "$want" ] || fail "neuflow $*: exit $got, expected $want"
+  if [ -n "$pattern" ]; then grep -Eq -- "$pattern" "$out/err" || fail "neuflow $*: stderr lacks /$pattern/"; fi
+  echo "ok: neuflow $* -> $got"
+}
+
+expect 64 "Subcommands:.*|flow" 
+expect 64 "not expected: --bogus" compare --bogus a.flo b.flo
+expect 64 "not expected: --modle" flow --modle m.pth a.png b.png out.flo
+grep -q "required" "$out/err" && fail "the unknown option must be reported instead of the missing --model"
+expect 64 "model is required|--model.*required" flow a.png b.png out.flo
+expect 64 "" no-such-subcommand
+expect 64 "nothing to convert" convert -m m.pth -o "$out/o"
+expect 64 "expected a multiple of 16" convert -m m.pth -o "$out/o" --model-width 100 --model-height 64 a.mp4
+expect 64 "Value -1 not in range|not in range" flow -m m.pth --iters-s8 -1 a.png b.png out.flo
+"$neuflow" --help >/dev/null 2>&1 || fail "--help must exit 0"
+"$neuflow" flow --help >/dev/null 2>&1 || fail "flow --help must exit 0"
+[ "$("$neuflow" --version)" != "" ] || fail "--version prints the version"
+echo "all usage checks passed"
