@@ -98,7 +98,8 @@ void Daemon::retire(std::unique_ptr<Stream> stream, std::function<void()> then) 
   });
 }
 
-void Daemon::apply(Config next) {
+std::string Daemon::apply(Config next) {
+  int unchanged = 0, restarted = 0, removed = 0, added = 0;
   const Config previous = std::move(config_);
   config_ = std::move(next);
   if (!log_level_override_.empty()) config_.daemon.log_level = log_level_override_;
@@ -120,6 +121,7 @@ void Daemon::apply(Config next) {
     if (keep) {
       wanted.erase(w);
       ++it;
+      ++unchanged;
       continue;
     }
     std::unique_ptr<Stream> old = std::move(it->second);
@@ -127,8 +129,10 @@ void Daemon::apply(Config next) {
     if (w == wanted.end()) {
       log_notice("stream " + old->name() + ": removed from the config");
       retire(std::move(old));
+      ++removed;
     } else {
       log_notice("stream " + old->name() + ": settings changed, restarting it");
+      ++restarted;
       const StreamConfig changed = *w->second;
       wanted.erase(w);
       // The new pipeline starts once the old one has let go of its camera and files.
@@ -137,8 +141,23 @@ void Daemon::apply(Config next) {
       });
     }
   }
-  for (const auto& [name, stream] : wanted) start_stream(*stream);
+  for (const auto& [name, stream] : wanted) {
+    start_stream(*stream);
+    ++added;
+  }
   update_servers();
+
+  std::string outcome;
+  const auto part = [&](int n, const char* what) {
+    if (n == 0) return;
+    outcome += (outcome.empty() ? "" : ", ") + std::to_string(n) + " stream" + (n == 1 ? " " : "s ") + what;
+  };
+  part(restarted, "restarted");
+  part(added, "added");
+  part(removed, "removed");
+  if (outcome.empty()) return "nothing changed";
+  part(unchanged, "unchanged");
+  return outcome;
 }
 
 void Daemon::update_servers() {
@@ -193,14 +212,16 @@ std::string Daemon::render_metrics() {
     m.frames_processed = s.frames_processed;
     m.frames_dropped = s.frames_dropped;
     m.restarts = s.restarts;
-    m.sink_failures = s.sink_failures;
-    m.latency_ms_mean = s.latency_ms;
-    m.processing_fps = s.rate_fps;
+    m.inference = s.inference;
     m.flows = s.flows;
     m.uptime_s = s.state == StreamState::playing ? s.seconds_in_state : 0.0;
+    for (const auto& sink : s.sinks) {
+      m.sinks.push_back({sink.name, sink.kind, sink.counts_flows, sink.flows_written, sink.failures});
+    }
     all.push_back(std::move(m));
   }
-  return render_prometheus(all, std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count());
+  return render_prometheus(all, std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count(),
+                           NEUFLOW_VERSION);
 }
 
 std::string Daemon::status_line() const {
@@ -216,7 +237,7 @@ void Daemon::reload() {
   log_notice("reloading " + config_.file.string());
   notifier_.reloading("reloading " + config_.file.string());
   try {
-    apply(load_config(config_.file));
+    log_notice("reloaded " + config_.file.string() + ": " + apply(load_config(config_.file)));
   } catch (const ConfigError& e) {
     for (const ConfigIssue& issue : e.issues()) log_error(issue.to_string());
     log_error("the new config has errors; the running streams keep their settings");

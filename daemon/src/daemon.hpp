@@ -39,7 +39,9 @@ class Daemon {
   static gboolean on_tick(gpointer self);
   static gboolean on_watchdog(gpointer self);
 
-  void apply(Config config);   // start, or move from the running config to this one
+  // Start, or move from the running config to this one; returns what changed, e.g.
+  // "1 stream restarted, 2 unchanged" or "nothing changed".
+  std::string apply(Config config);
   void reload();
   void shutdown();
   void start_stream(const StreamConfig& config);

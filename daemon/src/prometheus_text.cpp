@@ -48,8 +48,20 @@ class Exposition {
     text_ += '\n';
   }
 
-  void sample(std::string_view labels, const std::string& value) {
+  void sample(std::string_view labels, const std::string& value) { sample(std::string_view(), labels, value); }
+  void sample(std::string_view labels, std::uint64_t value) { sample(labels, std::to_string(value)); }
+  void sample(std::string_view labels, double value) { sample(labels, format_sample_value(value)); }
+
+  // A sample of the family under a suffixed name (a histogram's _bucket, _sum and _count).
+  void sample(std::string_view suffix, std::string_view labels, std::uint64_t value) {
+    sample(suffix, labels, std::to_string(value));
+  }
+  void sample(std::string_view suffix, std::string_view labels, double value) {
+    sample(suffix, labels, format_sample_value(value));
+  }
+  void sample(std::string_view suffix, std::string_view labels, const std::string& value) {
     text_ += name_;
+    text_ += suffix;
     if (!labels.empty()) {
       text_ += '{';
       text_ += labels;
@@ -59,8 +71,6 @@ class Exposition {
     text_ += value;
     text_ += '\n';
   }
-  void sample(std::string_view labels, std::uint64_t value) { sample(labels, std::to_string(value)); }
-  void sample(std::string_view labels, double value) { sample(labels, format_sample_value(value)); }
 
   std::string take() { return std::move(text_); }
 
@@ -75,8 +85,11 @@ std::string stream_label(const StreamMetrics& s) {
 
 }  // namespace
 
-std::string render_prometheus(const std::vector<StreamMetrics>& streams, double daemon_uptime_s) {
+std::string render_prometheus(const std::vector<StreamMetrics>& streams, double daemon_uptime_s,
+                              std::string_view version) {
   Exposition out;
+  out.family("neuflow_build_info", "gauge", "Always 1; the version of neuflowd in its label.");
+  out.sample("version=\"" + escape_label_value(version) + "\"", std::uint64_t{1});
   out.family("neuflow_daemon_uptime_seconds", "gauge", "Seconds since neuflowd started.");
   out.sample("", daemon_uptime_s);
   if (streams.empty()) return out.take();
@@ -105,25 +118,49 @@ std::string render_prometheus(const std::vector<StreamMetrics>& streams, double 
              });
   per_stream("neuflow_frames_in_total", "counter", "Frames that reached the flow element.",
              [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.frames_in); });
-  per_stream("neuflow_frames_processed_total", "counter", "Frames the network computed a flow for.",
+  per_stream("neuflow_frames_processed_total", "counter",
+             "Frames that left the flow element, with or without a flow (the first frame of a stream has none).",
              [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.frames_processed); });
   per_stream("neuflow_frames_dropped_total", "counter",
              "Frames dropped before inference because a newer frame had arrived (live mode).",
              [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.frames_dropped); });
-  per_stream("neuflow_flows_total", "counter", "Flow fields delivered to the stream's sinks.",
+  per_stream("neuflow_flows_total", "counter", "Flow fields computed and passed on to the stream's sinks.",
              [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.flows); });
   per_stream("neuflow_stream_restarts_total", "counter", "Restarts of the stream after a failure or a stall.",
              [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.restarts); });
-  per_stream("neuflow_sink_failures_total", "counter", "Sinks of the stream that failed and were cut off.",
-             [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.sink_failures); });
-  per_stream("neuflow_inference_latency_seconds", "gauge",
-             "Mean inference time of the stream's recent flows (NaN before the first).",
-             [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.latency_ms_mean / 1000.0); });
-  per_stream("neuflow_processing_fps", "gauge", "Flows computed per second, recently.",
-             [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.processing_fps); });
+  per_stream("neuflow_inference_seconds", "histogram", "Inference time of each flow, in seconds.",
+             [&](const StreamMetrics& s, const std::string& l) {
+               std::uint64_t cumulative = 0;
+               for (std::size_t i = 0; i < LatencyCounts::kBounds.size(); ++i) {
+                 cumulative += s.inference.buckets[i];
+                 out.sample("_bucket", l + ",le=\"" + format_sample_value(LatencyCounts::kBounds[i]) + "\"",
+                            cumulative);
+               }
+               out.sample("_bucket", l + ",le=\"+Inf\"", s.inference.count);
+               out.sample("_sum", l, s.inference.sum);
+               out.sample("_count", l, s.inference.count);
+             });
   per_stream("neuflow_stream_uptime_seconds", "gauge",
              "Seconds since the stream last started playing; 0 while it is not playing.",
              [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.uptime_s); });
+  const auto per_sink = [&](const char* name, const char* help, bool counted_only,
+                            const std::function<std::uint64_t(const SinkMetrics&)>& value) {
+    bool any = false;
+    for (const auto& s : streams) {
+      for (const auto& sink : s.sinks) {
+        if (counted_only && !sink.counts_flows) continue;
+        if (!any) out.family(name, "counter", help);
+        any = true;
+        out.sample(stream_label(s) + ",sink=\"" + escape_label_value(sink.sink) + "\",kind=\"" +
+                       escape_label_value(sink.kind) + "\"",
+                   value(sink));
+      }
+    }
+  };
+  per_sink("neuflow_sink_flows_written_total", "Flows the sink wrote (flow files, or flows published into the ring).",
+           true, [](const SinkMetrics& sink) { return sink.flows_written; });
+  per_sink("neuflow_sink_failures_total", "Times the sink failed or could not be built and was cut off.", false,
+           [](const SinkMetrics& sink) { return sink.failures; });
   return out.take();
 }
 

@@ -7,7 +7,18 @@
 #include <string_view>
 #include <vector>
 
+#include "latency_histogram.hpp"
+
 namespace neuflow::daemon {
+
+// One sink of a stream. Counters count since the daemon started, like the stream's.
+struct SinkMetrics {
+  std::string sink;            // SinkConfig::name
+  std::string kind;            // pipeline::sink_kind(): "files", "shm", "video-file", "rtsp", "udp", "display"
+  bool counts_flows = false;   // files and shm sinks count what they write
+  std::uint64_t flows_written = 0;
+  std::uint64_t failures = 0;  // times it failed (or could not be built) and was cut off
+};
 
 // One stream as the daemon last saw it. The counters should count since the daemon started,
 // summed over the stream's restarts: Prometheus reads any decrease as a counter reset.
@@ -15,14 +26,13 @@ struct StreamMetrics {
   std::string stream;          // StreamConfig::name; unique within a snapshot
   std::string state;           // "playing", "starting", "backoff", "stopped", "finished"
   std::uint64_t frames_in = 0;
-  std::uint64_t frames_processed = 0;
+  std::uint64_t frames_processed = 0;  // frames that left the flow element, with or without flow
   std::uint64_t frames_dropped = 0;
   std::uint64_t flows = 0;           // flow fields delivered to the sinks
   std::uint64_t restarts = 0;
-  std::uint64_t sink_failures = 0;
-  double latency_ms_mean = 0.0;      // mean inference time of recent flows; NaN: none yet
-  double processing_fps = 0.0;       // flows per second, recent
+  LatencyCounts inference;           // inference time of each flow
   double uptime_s = 0.0;             // since the stream last reached "playing"; 0 when not playing
+  std::vector<SinkMetrics> sinks;    // in config order
 };
 
 // The states render_prometheus reports as neuflow_stream_state series, one each per stream.
@@ -31,9 +41,10 @@ inline constexpr const char* kStreamStates[] = {"playing", "starting", "backoff"
 
 // The whole exposition: one family per metric, each with its # HELP and # TYPE once, samples
 // ordered as the snapshot. Families of per-stream metrics are left out when there are no
-// streams. Latency is exported in seconds (Prometheus' base unit) as
-// neuflow_inference_latency_seconds.
-std::string render_prometheus(const std::vector<StreamMetrics>& streams, double daemon_uptime_s);
+// streams. Inference time is the histogram neuflow_inference_seconds (Prometheus' base unit);
+// rates come from rate() over the _total counters, so no gauge holds one.
+std::string render_prometheus(const std::vector<StreamMetrics>& streams, double daemon_uptime_s,
+                              std::string_view version);
 
 // A label value escaped for the text format: backslash, double quote and line feed become
 // \\, \" and \n; everything else (UTF-8 included) is kept.

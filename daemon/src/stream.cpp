@@ -1,10 +1,13 @@
 #include "stream.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <stdexcept>
 
 #include "log.hpp"
+#include "neuflow/gst/flow_meta.h"
+#include "neuflow/pipeline/graph_plan.hpp"
 
 namespace neuflow::daemon {
 
@@ -79,12 +82,42 @@ Stream::Stream(StreamConfig config, int threads, DaemonSettings settings, Stream
       settings_(settings),
       backoff_s_(settings.restart_delay_min),
       base_{carried.frames_in, carried.frames_processed, carried.frames_dropped, carried.flows},
+      sink_base_(std::move(carried.sinks)),
+      inference_(carried.inference),
       restarts_(carried.restarts),
       sink_failures_(carried.sink_failures) {}
 
 StreamTotals Stream::totals() const {
   const StreamSnapshot s = snapshot();
-  return {s.frames_in, s.frames_processed, s.frames_dropped, s.flows, s.restarts, s.sink_failures};
+  StreamTotals t{s.frames_in, s.frames_processed, s.frames_dropped, s.flows, s.restarts, s.sink_failures,
+                 s.inference, {}};
+  for (const auto& sink : s.sinks) t.sinks[sink.name] = {sink.flows_written, sink.failures};
+  return t;
+}
+
+void Stream::count_sink_failure(const std::string& sink) {
+  ++sink_failures_;
+  ++sink_base_[sink].failures;
+}
+
+// Each flow's inference time, from the meta the neuflow element attaches. The meta's API type
+// is looked up by name: the daemon reads the struct (neuflow/gst/flow_meta.h) without linking
+// the plugin's library, which the plugin has loaded into this process.
+GstPadProbeReturn Stream::on_flow_buffer(GstPad*, GstPadProbeInfo* info, gpointer self) {
+  // Registered when the first meta is attached, so not known before the first flow.
+  static std::atomic<GType> known{0};
+  GType api = known.load(std::memory_order_relaxed);
+  if (api == 0) {
+    api = g_type_from_name("NeuflowFlowMetaAPI");
+    if (api == 0) return GST_PAD_PROBE_OK;
+    known.store(api, std::memory_order_relaxed);
+  }
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  const auto* meta = buffer ? reinterpret_cast<const NeuflowFlowMeta*>(gst_buffer_get_meta(buffer, api)) : nullptr;
+  if (meta && meta->width > 0 && GST_CLOCK_TIME_IS_VALID(meta->inference_time)) {
+    static_cast<Stream*>(self)->inference_.record(static_cast<double>(meta->inference_time) / GST_SECOND);
+  }
+  return GST_PAD_PROBE_OK;
 }
 
 Stream::~Stream() {
@@ -110,7 +143,7 @@ void Stream::start() {
     return;
   }
   for (const UnbuiltSink& sink : graph_->unbuilt_sinks()) {
-    ++sink_failures_;
+    count_sink_failure(sink.name);
     log_error("stream " + config_.name + ": sink " + sink.name + " cannot be built: " + sink.reason +
               "; the stream goes on with its other sinks (tried again at its next restart or reload)");
   }
@@ -119,9 +152,16 @@ void Stream::start() {
   bus_watch_ = gst_bus_add_watch(bus, &Stream::on_bus_message, this);
   gst_object_unref(bus);
 
+  if (GstPad* src = gst_element_get_static_pad(graph_->flow_element(), "src")) {
+    gst_pad_add_probe(src, GST_PAD_PROBE_TYPE_BUFFER, &Stream::on_flow_buffer, this, nullptr);
+    gst_object_unref(src);
+  }
+
   current_ = {};
+  sink_written_now_.clear();
   last_processed_ = 0;
   rate_base_ = 0;
+  rate_known_ = false;
   last_rate_at_ = last_progress_ = Clock::now();
   enter(StreamState::starting);
   log_info("stream " + config_.name + ": starting (" + describe_source(config_.source) + ", " +
@@ -139,7 +179,7 @@ void Stream::start() {
     if (branch && !branch->removed) {
       branch->failed.store(true, std::memory_order_release);
       if (graph_->live_branches() > 0) {
-        ++sink_failures_;
+        count_sink_failure(branch->name);
         log_error("stream " + config_.name + ": sink " + branch->name + " failed: " + text +
                   "; the stream goes on with its other sinks");
         gst_element_set_state(graph_->pipeline(), GST_STATE_NULL);
@@ -160,6 +200,8 @@ void Stream::teardown() {
   base_.dropped += current_.dropped;
   base_.flows += current_.flows;
   current_ = {};
+  for (const auto& [sink, written] : sink_written_now_) sink_base_[sink].flows_written += written;
+  sink_written_now_.clear();
   if (bus_watch_) {
     g_source_remove(bus_watch_);
     bus_watch_ = 0;
@@ -261,7 +303,7 @@ void Stream::handle_message(GstMessage* message) {
       SinkBranch* branch = graph_->branch_of(GST_MESSAGE_SRC(message));
       if (branch && state_ != StreamState::stopping && graph_->live_branches() > 0) {
         if (!branch->removed) {
-          ++sink_failures_;
+          count_sink_failure(branch->name);
           log_error("stream " + config_.name + ": sink " + branch->name + " failed: " + text +
                     "; the stream goes on with its other sinks");
           graph_->remove_branch(*branch);
@@ -320,6 +362,9 @@ void Stream::read_counters() {
   current_.processed = uint64_property(flow, "frames-processed");
   current_.dropped = uint64_property(flow, "frames-dropped");
   current_.flows = uint64_property(flow, "flows");
+  for (const auto& branch : graph_->sinks()) {
+    if (branch->writer) sink_written_now_[branch->name] = uint64_property(branch->writer, "flows-written");
+  }
   g_object_get(flow, "mean-latency", &latency_ms_, nullptr);
 }
 
@@ -330,6 +375,7 @@ void Stream::tick() {
   const double dt = std::chrono::duration<double>(now - last_rate_at_).count();
   if (dt >= 1.0) {
     rate_fps_ = static_cast<double>(current_.processed - rate_base_) / dt;
+    rate_known_ = true;
     rate_base_ = current_.processed;
     last_rate_at_ = now;
   }
@@ -366,6 +412,20 @@ StreamSnapshot Stream::snapshot() const {
   s.rate_fps = rate_fps_;
   s.restarts = restarts_;
   s.sink_failures = sink_failures_;
+  s.inference = inference_.counts();
+  for (const SinkConfig& sink : config_.sinks) {
+    StreamSnapshot::Sink out;
+    out.name = sink.name;
+    out.kind = std::string(pipeline::sink_kind(sink.settings));
+    out.counts_flows = std::holds_alternative<FilesSink>(sink.settings) || std::holds_alternative<ShmSink>(sink.settings);
+    const auto base = sink_base_.find(sink.name);
+    if (base != sink_base_.end()) {
+      out.flows_written = base->second.flows_written;
+      out.failures = base->second.failures;
+    }
+    if (const auto now = sink_written_now_.find(sink.name); now != sink_written_now_.end()) out.flows_written += now->second;
+    s.sinks.push_back(std::move(out));
+  }
   s.seconds_in_state = seconds_since(state_since_);
   if (state_ == StreamState::backoff) {
     s.retry_in_s = std::max(0.0, std::chrono::duration<double>(restart_at_ - Clock::now()).count());
@@ -377,7 +437,12 @@ std::string Stream::status() const {
   char buf[160];
   switch (state_) {
     case StreamState::playing:
-      std::snprintf(buf, sizeof buf, "%s %.1f fps", config_.name.c_str(), rate_fps_);
+      // No rate before one has been measured: "0.0 fps" would be a figure nobody measured.
+      if (rate_known_) {
+        std::snprintf(buf, sizeof buf, "%s %.1f fps", config_.name.c_str(), rate_fps_);
+      } else {
+        std::snprintf(buf, sizeof buf, "%s playing", config_.name.c_str());
+      }
       break;
     case StreamState::backoff:
       std::snprintf(buf, sizeof buf, "%s retry in %.0f s", config_.name.c_str(), snapshot().retry_in_s);

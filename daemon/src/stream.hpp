@@ -9,10 +9,13 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "config.hpp"
+#include "latency_histogram.hpp"
 #include "neuflow/pipeline/stream_graph.hpp"
 
 namespace neuflow::daemon {
@@ -34,9 +37,24 @@ struct StreamSnapshot {
   double latency_ms = 0;               // mean inference time of the current run
   double rate_fps = 0;                 // frames leaving the flow element per second, recently
   std::uint64_t restarts = 0;
-  std::uint64_t sink_failures = 0;
+  std::uint64_t sink_failures = 0;     // all sinks together
+  LatencyCounts inference;             // every flow's inference time, over all runs
   double seconds_in_state = 0;
   double retry_in_s = 0;               // backoff only
+  struct Sink {
+    std::string name;
+    std::string kind;                  // pipeline::sink_kind()
+    bool counts_flows = false;         // files and shm sinks count what they write
+    std::uint64_t flows_written = 0;   // over all runs
+    std::uint64_t failures = 0;
+  };
+  std::vector<Sink> sinks;             // in config order
+};
+
+// One sink's counts since the daemon started.
+struct SinkTotals {
+  std::uint64_t flows_written = 0;
+  std::uint64_t failures = 0;
 };
 
 // What a stream has counted since the daemon started, carried from one Stream object to the
@@ -48,6 +66,8 @@ struct StreamTotals {
   std::uint64_t flows = 0;
   std::uint64_t restarts = 0;
   std::uint64_t sink_failures = 0;
+  LatencyCounts inference;
+  std::map<std::string, SinkTotals> sinks;  // by sink name
 };
 
 class Stream {
@@ -87,6 +107,8 @@ class Stream {
   static GstBusSyncReply on_bus_sync(GstBus*, GstMessage* message, gpointer graph);
   static gboolean on_restart_timer(gpointer self);
   static gboolean on_stop_timeout(gpointer self);
+  static GstPadProbeReturn on_flow_buffer(GstPad*, GstPadProbeInfo* info, gpointer self);
+  void count_sink_failure(const std::string& sink);
 
   void handle_message(GstMessage* message);
   void fail(const std::string& reason);
@@ -122,6 +144,13 @@ class Stream {
   std::uint64_t last_processed_ = 0;  // for stall detection
   std::uint64_t rate_base_ = 0;       // processed count at the last rate measurement
   Clock::time_point last_rate_at_{};
+  bool rate_known_ = false;           // a rate has been measured in this run
+  // Per sink: what finished runs wrote (and failures), and what the running pipeline wrote.
+  std::map<std::string, SinkTotals> sink_base_;
+  std::map<std::string, std::uint64_t> sink_written_now_;
+  // Filled from the flow element's src pad (a streaming thread), read by scrapes.
+  LatencyHistogram inference_;
+  gulong inference_probe_ = 0;
   std::uint64_t restarts_ = 0;
   std::uint64_t sink_failures_ = 0;
 };

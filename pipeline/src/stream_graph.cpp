@@ -146,7 +146,8 @@ std::unique_ptr<StreamGraph> build_stream_graph(const GraphDescription& descript
     try {
       const SinkPlan plan = plan_sink(description.name, sink, context);
       create_folders(plan.folders);
-      GstElement* first = add_chain(GST_BIN(branch->bin), plan.chain).first;
+      const auto [first, last] = add_chain(GST_BIN(branch->bin), plan.chain);
+      if (g_object_class_find_property(G_OBJECT_GET_CLASS(last), "flows-written")) branch->writer = last;
       GstPad* first_sink = gst_element_get_static_pad(first, "sink");
       GstPad* ghost = gst_ghost_pad_new("sink", first_sink);
       gst_object_unref(first_sink);

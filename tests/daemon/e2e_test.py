@@ -274,6 +274,10 @@ class DaemonLifecycle(DaemonTestCase):
         self.assertIn("stream clip: settings changed", log)
         self.assertNotIn("stream pattern: settings changed", log)
         self.assertEqual(log.count("stream pattern: starting"), 1, log[-3000:])
+        # Each reload ends with one line that says how it ended.
+        self.assertRegex(log, r"reloaded .*: 1 stream restarted, 1 stream unchanged")
+        d.proc.send_signal(signal.SIGHUP)
+        d.wait_log(r"reloaded .*: nothing changed", timeout=30)
 
         code = d.stop()
         self.assertEqual(code, 0, d.log_text()[-3000:])
@@ -418,6 +422,17 @@ class DaemonFailures(DaemonTestCase):
         self.assertGreaterEqual(int(restarts.group(1)), 2)
         processed = re.search(r'neuflow_frames_processed_total\{stream="good"\} (\d+)', body)
         self.assertGreater(int(processed.group(1)), 0)
+        # Prometheus conventions: inference time as a histogram, per-sink counters with a sink
+        # label, the version in neuflow_build_info, no rate gauges.
+        inferences = re.search(r'neuflow_inference_seconds_count\{stream="good"\} (\d+)', body)
+        self.assertIsNotNone(inferences, body)
+        self.assertGreater(int(inferences.group(1)), 0)
+        self.assertRegex(body, r'neuflow_inference_seconds_bucket\{stream="good",le="\+Inf"\} \d+')
+        written = re.search(r'neuflow_sink_flows_written_total\{stream="good",sink="[^"]+",kind="files"\} (\d+)', body)
+        self.assertIsNotNone(written, body)
+        self.assertGreater(int(written.group(1)), 0)
+        self.assertRegex(body, r'neuflow_build_info\{version="[^"]+"\} 1')
+        self.assertNotIn("fps", body)
         self.assertEqual(d.stop(), 0)
 
     def test_failing_sink_is_cut_off_and_the_stream_goes_on(self):

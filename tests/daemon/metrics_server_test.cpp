@@ -114,8 +114,7 @@ std::vector<StreamMetrics> one_stream() {
   s.frames_in = 10;
   s.frames_processed = 9;
   s.flows = 8;
-  s.latency_ms_mean = 40;
-  s.processing_fps = 15;
+  s.inference.add(0.04);
   return {s};
 }
 
@@ -180,7 +179,7 @@ TEST(MetricsServer, ServesTheRenderedTextAtMetrics) {
   MetricsServer server("127.0.0.1", 0, [&] {
     ++calls;
     on_loop_thread = on_loop_thread && std::this_thread::get_id() == loop_thread;
-    return render_prometheus(one_stream(), 12.0);
+    return render_prometheus(one_stream(), 12.0, "1.0");
   });
   ASSERT_GT(server.port(), 0);
   EXPECT_EQ(server.url(), base_url(server) + "/metrics");
@@ -190,7 +189,7 @@ TEST(MetricsServer, ServesTheRenderedTextAtMetrics) {
   ASSERT_EQ(r.error, "");
   EXPECT_EQ(r.status, 200u);
   EXPECT_EQ(r.content_type, "text/plain; version=0.0.4; charset=utf-8");
-  EXPECT_EQ(r.body, render_prometheus(one_stream(), 12.0));
+  EXPECT_EQ(r.body, render_prometheus(one_stream(), 12.0, "1.0"));
   EXPECT_EQ(calls, 1);
   EXPECT_TRUE(on_loop_thread);
 
@@ -205,7 +204,7 @@ TEST(MetricsServer, ServesTheRenderedTextAtMetrics) {
 TEST(MetricsServer, AnswersCurl) {
   gchar* curl = g_find_program_in_path("curl");
   if (curl == nullptr) GTEST_SKIP() << "curl is not installed";
-  MetricsServer server("127.0.0.1", 0, [] { return render_prometheus(one_stream(), 1.0); });
+  MetricsServer server("127.0.0.1", 0, [] { return render_prometheus(one_stream(), 1.0, "1.0"); });
   GError* error = nullptr;
   GSubprocess* child = g_subprocess_new(G_SUBPROCESS_FLAGS_STDOUT_PIPE, &error, curl, "--silent", "--show-error",
                                         "--noproxy", "*", "--include", "--max-time", "5", server.url().c_str(),
@@ -236,7 +235,7 @@ TEST(MetricsServer, AnswersCurl) {
   EXPECT_NE(out.find("\r\nConnection: close\r\n"), std::string::npos) << out;
   const auto body = out.find("\r\n\r\n");
   ASSERT_NE(body, std::string::npos);
-  EXPECT_EQ(out.substr(body + 4), render_prometheus(one_stream(), 1.0));
+  EXPECT_EQ(out.substr(body + 4), render_prometheus(one_stream(), 1.0, "1.0"));
 }
 
 TEST(MetricsServer, AnswersHeadWithHeadersOnly) {

@@ -27,22 +27,22 @@ std::vector<StreamMetrics> known_snapshot() {
   front.frames_dropped = 50;
   front.flows = 1149;
   front.restarts = 1;
-  front.sink_failures = 0;
-  front.latency_ms_mean = 42.5;
-  front.processing_fps = 14.25;
+  for (const double seconds : {0.125, 0.25, 0.5}) front.inference.add(seconds);  // 0.25 is on a bound: le="0.25"
   front.uptime_s = 81.5;
+  front.sinks = {{"archive", "files", true, 1149, 0}, {"live", "rtsp", false, 0, 1}};
 
   StreamMetrics odd;
   odd.stream = "odd \"name\"\\ with\nnewline";
   odd.state = "backoff";
   odd.restarts = 3;
-  odd.sink_failures = 2;
-  odd.latency_ms_mean = std::numeric_limits<double>::quiet_NaN();
   return {front, odd};
 }
 
 TEST(PrometheusText, RendersKnownSnapshotExactly) {
-  const std::string expected = R"(# HELP neuflow_daemon_uptime_seconds Seconds since neuflowd started.
+  const std::string expected = R"(# HELP neuflow_build_info Always 1; the version of neuflowd in its label.
+# TYPE neuflow_build_info gauge
+neuflow_build_info{version="1.2.3"} 1
+# HELP neuflow_daemon_uptime_seconds Seconds since neuflowd started.
 # TYPE neuflow_daemon_uptime_seconds gauge
 neuflow_daemon_uptime_seconds 120.25
 # HELP neuflow_stream_up 1 while the stream is playing, else 0.
@@ -65,7 +65,7 @@ neuflow_stream_state{stream="odd \"name\"\\ with\nnewline",state="finished"} 0
 # TYPE neuflow_frames_in_total counter
 neuflow_frames_in_total{stream="front"} 1200
 neuflow_frames_in_total{stream="odd \"name\"\\ with\nnewline"} 0
-# HELP neuflow_frames_processed_total Frames the network computed a flow for.
+# HELP neuflow_frames_processed_total Frames that left the flow element, with or without a flow (the first frame of a stream has none).
 # TYPE neuflow_frames_processed_total counter
 neuflow_frames_processed_total{stream="front"} 1150
 neuflow_frames_processed_total{stream="odd \"name\"\\ with\nnewline"} 0
@@ -73,7 +73,7 @@ neuflow_frames_processed_total{stream="odd \"name\"\\ with\nnewline"} 0
 # TYPE neuflow_frames_dropped_total counter
 neuflow_frames_dropped_total{stream="front"} 50
 neuflow_frames_dropped_total{stream="odd \"name\"\\ with\nnewline"} 0
-# HELP neuflow_flows_total Flow fields delivered to the stream's sinks.
+# HELP neuflow_flows_total Flow fields computed and passed on to the stream's sinks.
 # TYPE neuflow_flows_total counter
 neuflow_flows_total{stream="front"} 1149
 neuflow_flows_total{stream="odd \"name\"\\ with\nnewline"} 0
@@ -81,28 +81,58 @@ neuflow_flows_total{stream="odd \"name\"\\ with\nnewline"} 0
 # TYPE neuflow_stream_restarts_total counter
 neuflow_stream_restarts_total{stream="front"} 1
 neuflow_stream_restarts_total{stream="odd \"name\"\\ with\nnewline"} 3
-# HELP neuflow_sink_failures_total Sinks of the stream that failed and were cut off.
-# TYPE neuflow_sink_failures_total counter
-neuflow_sink_failures_total{stream="front"} 0
-neuflow_sink_failures_total{stream="odd \"name\"\\ with\nnewline"} 2
-# HELP neuflow_inference_latency_seconds Mean inference time of the stream's recent flows (NaN before the first).
-# TYPE neuflow_inference_latency_seconds gauge
-neuflow_inference_latency_seconds{stream="front"} 0.0425
-neuflow_inference_latency_seconds{stream="odd \"name\"\\ with\nnewline"} NaN
-# HELP neuflow_processing_fps Flows computed per second, recently.
-# TYPE neuflow_processing_fps gauge
-neuflow_processing_fps{stream="front"} 14.25
-neuflow_processing_fps{stream="odd \"name\"\\ with\nnewline"} 0
+# HELP neuflow_inference_seconds Inference time of each flow, in seconds.
+# TYPE neuflow_inference_seconds histogram
+neuflow_inference_seconds_bucket{stream="front",le="0.01"} 0
+neuflow_inference_seconds_bucket{stream="front",le="0.025"} 0
+neuflow_inference_seconds_bucket{stream="front",le="0.05"} 0
+neuflow_inference_seconds_bucket{stream="front",le="0.1"} 0
+neuflow_inference_seconds_bucket{stream="front",le="0.25"} 2
+neuflow_inference_seconds_bucket{stream="front",le="0.5"} 3
+neuflow_inference_seconds_bucket{stream="front",le="1"} 3
+neuflow_inference_seconds_bucket{stream="front",le="2.5"} 3
+neuflow_inference_seconds_bucket{stream="front",le="5"} 3
+neuflow_inference_seconds_bucket{stream="front",le="10"} 3
+neuflow_inference_seconds_bucket{stream="front",le="30"} 3
+neuflow_inference_seconds_bucket{stream="front",le="60"} 3
+neuflow_inference_seconds_bucket{stream="front",le="+Inf"} 3
+neuflow_inference_seconds_sum{stream="front"} 0.875
+neuflow_inference_seconds_count{stream="front"} 3
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="0.01"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="0.025"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="0.05"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="0.1"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="0.25"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="0.5"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="1"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="2.5"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="5"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="10"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="30"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="60"} 0
+neuflow_inference_seconds_bucket{stream="odd \"name\"\\ with\nnewline",le="+Inf"} 0
+neuflow_inference_seconds_sum{stream="odd \"name\"\\ with\nnewline"} 0
+neuflow_inference_seconds_count{stream="odd \"name\"\\ with\nnewline"} 0
 # HELP neuflow_stream_uptime_seconds Seconds since the stream last started playing; 0 while it is not playing.
 # TYPE neuflow_stream_uptime_seconds gauge
 neuflow_stream_uptime_seconds{stream="front"} 81.5
 neuflow_stream_uptime_seconds{stream="odd \"name\"\\ with\nnewline"} 0
+# HELP neuflow_sink_flows_written_total Flows the sink wrote (flow files, or flows published into the ring).
+# TYPE neuflow_sink_flows_written_total counter
+neuflow_sink_flows_written_total{stream="front",sink="archive",kind="files"} 1149
+# HELP neuflow_sink_failures_total Times the sink failed or could not be built and was cut off.
+# TYPE neuflow_sink_failures_total counter
+neuflow_sink_failures_total{stream="front",sink="archive",kind="files"} 0
+neuflow_sink_failures_total{stream="front",sink="live",kind="rtsp"} 1
 )";
-  EXPECT_EQ(render_prometheus(known_snapshot(), 120.25), expected);
+  EXPECT_EQ(render_prometheus(known_snapshot(), 120.25, "1.2.3"), expected);
 }
 
 TEST(PrometheusText, WithoutStreamsOnlyTheDaemonIsReported) {
-  EXPECT_EQ(render_prometheus({}, 0.5),
+  EXPECT_EQ(render_prometheus({}, 0.5, "1.2.3"),
+            "# HELP neuflow_build_info Always 1; the version of neuflowd in its label.\n"
+            "# TYPE neuflow_build_info gauge\n"
+            "neuflow_build_info{version=\"1.2.3\"} 1\n"
             "# HELP neuflow_daemon_uptime_seconds Seconds since neuflowd started.\n"
             "# TYPE neuflow_daemon_uptime_seconds gauge\n"
             "neuflow_daemon_uptime_seconds 0.5\n");
@@ -133,7 +163,7 @@ TEST(PrometheusText, UnknownStateIsStillReported) {
   StreamMetrics s;
   s.stream = "cam";
   s.state = "paused";
-  const std::string text = render_prometheus({s}, 1.0);
+  const std::string text = render_prometheus({s}, 1.0, "1.2.3");
   EXPECT_NE(text.find("neuflow_stream_state{stream=\"cam\",state=\"paused\"} 1\n"), std::string::npos) << text;
   EXPECT_NE(text.find("neuflow_stream_state{stream=\"cam\",state=\"playing\"} 0\n"), std::string::npos) << text;
   EXPECT_NE(text.find("neuflow_stream_up{stream=\"cam\"} 0\n"), std::string::npos) << text;
@@ -193,8 +223,14 @@ Parsed parse_exposition(const std::string& text) {
       p.types[m[1]] = m[2];
       help_seen = false;
     } else if (std::regex_match(line, m, sample)) {
-      if (m[1] != current || !p.types.count(current))
-        p.errors.push_back(at + "sample of " + m[1].str() + " outside its family");
+      const std::string name = m[1];
+      const bool histogram_part = p.types.count(current) && p.types[current] == "histogram" &&
+                                  (name == current + "_bucket" || name == current + "_sum" ||
+                                   name == current + "_count");
+      if ((name != current && !histogram_part) || !p.types.count(current))
+        p.errors.push_back(at + "sample of " + name + " outside its family");
+      if (p.types.count(current) && p.types[current] == "histogram" && !histogram_part)
+        p.errors.push_back(at + "histogram sample " + name + " is not a _bucket, _sum or _count");
       if (p.types[current] == "counter" && !current.ends_with("_total"))
         p.errors.push_back(at + "counter not named *_total");
       std::map<std::string, std::string> labels;
@@ -229,6 +265,7 @@ TEST(PrometheusText, GrammarCheckRejectsBrokenExpositions) {
       "# HELP x h\n# TYPE x gauge\nx 1\n# HELP x h\n# TYPE x gauge\n",          // repeated family
       "# HELP x h\n# TYPE x counter\nx 1\n",                  // counter without _total
       "# HELP x h\n# TYPE x gauge\nx one\n",                  // not a number
+      "# HELP x h\n# TYPE x histogram\nx_total 1\n",          // not a histogram's sample
   };
   for (const char* text : broken) EXPECT_FALSE(parse_exposition(text).errors.empty()) << text;
   EXPECT_TRUE(parse_exposition("# HELP x h\n# TYPE x gauge\nx{a=\"\\\"\\n\"} -1.5e3\n").errors.empty());
@@ -239,14 +276,17 @@ TEST(PrometheusText, OutputFollowsTheTextFormatGrammar) {
   StreamMetrics third;
   third.stream = "back\\\\slash\"\n\n";
   third.state = "finished";
-  third.processing_fps = std::numeric_limits<double>::infinity();
+  third.inference.add(std::numeric_limits<double>::infinity());  // not counted
+  third.inference.add(1e9);                                     // counted under +Inf
   third.frames_in = std::numeric_limits<std::uint64_t>::max();
+  third.sinks = {{"odd \"sink\"", "shm", true, 7, 2}};
   snapshot.push_back(third);
 
-  const Parsed p = parse_exposition(render_prometheus(snapshot, 3600.0));
+  const Parsed p = parse_exposition(render_prometheus(snapshot, 3600.0, "0.1.0-dev \"x\""));
   for (const auto& e : p.errors) ADD_FAILURE() << e;
 
-  EXPECT_EQ(p.types.size(), 12u);
+  EXPECT_EQ(p.types.size(), 13u);
+  EXPECT_EQ(p.types.at("neuflow_inference_seconds"), "histogram");
   std::set<std::string> streams;
   for (const auto& labels : p.labels) {
     if (labels.count("stream")) streams.insert(labels.at("stream"));

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,7 +35,37 @@ struct ConvertArgs {
   double max_flow = 20;
   bool resume = false;
   std::int64_t max_frames = 0;
+  std::string fps;    // --fps N or N/D
+  std::string shard;  // --shard K/N
 };
+
+// "N" or "N/D" frames per second, positive.
+pipeline::FrameRate parse_rate(const std::string& text) {
+  int numerator = 0, denominator = 1;
+  char rest = 0;
+  const int n = std::sscanf(text.c_str(), "%d/%d%c", &numerator, &denominator, &rest);
+  if ((n == 1 || n == 2) && numerator > 0 && denominator > 0 && numerator <= 1000 * denominator) {
+    return {numerator, denominator};
+  }
+  throw CommandError(kExitUsage, "--fps wants frames per second as N or N/D (e.g. 15 or 30000/1001), got '" + text + "'");
+}
+
+struct Shard {
+  std::size_t index = 0;  // K, from 0
+  std::size_t count = 1;  // N
+};
+
+// "K/N" with 0 <= K < N: the K-th of N shards, counted from 0 (SLURM_ARRAY_TASK_ID,
+// JOB_COMPLETION_INDEX).
+Shard parse_shard(const std::string& text) {
+  long k = -1, n = 0;
+  char rest = 0;
+  if (std::sscanf(text.c_str(), "%ld/%ld%c", &k, &n, &rest) == 2 && n > 0 && k >= 0 && k < n) {
+    return {static_cast<std::size_t>(k), static_cast<std::size_t>(n)};
+  }
+  throw CommandError(kExitUsage, "--shard wants K/N with 0 <= K < N (this job's index from 0, and the number of "
+                                 "jobs), got '" + text + "'");
+}
 
 int terminal_width(int fd) {
   winsize size{};
@@ -70,6 +101,9 @@ std::string summary_line(const InputSpec& input, const InputOutcome& outcome) {
 void run_convert(const ConvertArgs& a) {
   const model::SessionOptions options = session_options(a.session);
   if (a.inputs.empty() && a.pairs.empty()) throw CommandError(kExitUsage, "nothing to convert: give INPUT... or --pair A B");
+  const std::optional<pipeline::FrameRate> image_rate =
+      a.fps.empty() ? std::nullopt : std::optional<pipeline::FrameRate>(parse_rate(a.fps));
+  const Shard shard = a.shard.empty() ? Shard{} : parse_shard(a.shard);
 
   std::shared_ptr<const model::FlowModel> model;
   try {
@@ -88,12 +122,25 @@ void run_convert(const ConvertArgs& a) {
   settings.max_flow = a.max_flow;
   settings.resume = a.resume;
   settings.max_frames = a.max_frames;
+  settings.image_rate = image_rate;
 
   const int fd = ::fileno(stderr);
   const bool terminal = ::isatty(fd) != 0;
   Progress progress(stderr, terminal, terminal ? terminal_width(fd) : 80);
 
-  const auto inputs = plan_inputs(a.inputs, a.pairs);
+  // Every input is named as in a whole run before a shard takes its share, so the shards of one
+  // command line write exactly the folders the whole run would.
+  std::vector<InputSpec> inputs;
+  {
+    auto all = plan_inputs(a.inputs, a.pairs);
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      if (i % shard.count == shard.index) inputs.push_back(std::move(all[i]));
+    }
+  }
+  if (inputs.empty()) {
+    std::fprintf(stderr, "neuflow convert: shard %s has no inputs (fewer inputs than shards)\n", a.shard.c_str());
+    return;
+  }
   std::vector<InputOutcome> outcomes;
   for (const auto& input : inputs) {
     outcomes.push_back(convert_input(input, session, settings, progress));
@@ -137,7 +184,7 @@ void register_convert(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--viz", args->viz,
                   "Colour rendering of each flow: png (viz/<frame>.png), video (viz.mp4, H.264, at the video's frame "
-                  "rate, 10 fps for images) or none")
+                  "rate; for images --fps, else the rate their timestamp names give, else 10 fps) or none")
       ->check(CLI::IsMember({"none", "png", "video"}))
       ->capture_default_str();
   sub->add_option("--max-flow", args->max_flow,
@@ -155,6 +202,12 @@ void register_convert(CLI::App& app) {
                        : "--max-frames wants 0 (all frames) or a number of frames, got '" + value + "'";
           },
           "N"));
+  sub->add_option("--fps", args->fps,
+                  "Frame rate of images (N or N/D) for viz.mp4; default: from file names that are capture "
+                  "timestamps (10, 13, 16 or 19 digits: s, ms, us, ns), else 10. Videos keep their own rate");
+  sub->add_option("--shard", args->shard,
+                  "Convert only the K-th of N shares of the inputs (K/N, K from 0: every N-th input starting at the "
+                  "K-th), for job arrays; each input keeps the output folder name of a whole run");
   add_session_options(*sub, args->session);
   sub->add_option("INPUT", args->inputs,
                   "Folders of frames, video files or URIs, or two image files (a pair); several at once");

@@ -71,7 +71,14 @@ void run_fetch_model(const FetchModelArgs& a) {
   try {
     result = fetch_model(request);
   } catch (const FetchError& e) {
-    throw CommandError(fetch_exit_code(e), "fetch-model: " + std::string(e.what()));
+    std::string message = "fetch-model: " + std::string(e.what());
+    // Offline machines and blocked networks have the manual way.
+    if (e.kind() == FetchError::Kind::kUnavailable || e.kind() == FetchError::Kind::kInterrupted) {
+      message += "\n  the file can also be copied by hand: get " + std::string(model->file) +
+                 " from the NeuFlow-V2 repository (github.com/neufieldrobotics/NeuFlow_v2) and put it at " +
+                 request.destination.string() + "; `neuflow fetch-model " + a.name + "` then only verifies it";
+    }
+    throw CommandError(fetch_exit_code(e), message);
   }
   if (result.downloaded) {
     std::fprintf(stderr, "%s: downloaded %.1f MB from %s, git blob SHA-1 %s verified\n",

@@ -11,10 +11,14 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "common/exit_codes.hpp"
+#include "convert/frames.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -347,6 +351,91 @@ TEST_F(ConvertCli, MissingCheckpointFailsBeforeAnyInput) {
                                    (dir / "seq").string()});
   EXPECT_EQ(result.exit_code, 66) << result.output;
   EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+}  // namespace
+}  // namespace neuflow::cli
+
+namespace neuflow::cli {
+namespace {
+
+// Every file under `root` (relative path → bytes).
+std::map<std::string, std::string> tree(const fs::path& root) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::recursive_directory_iterator(root)) {
+    if (!entry.is_regular_file()) continue;
+    std::ifstream in(entry.path(), std::ios::binary);
+    files[fs::relative(entry.path(), root).string()] =
+        std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  return files;
+}
+
+// A job array splits the inputs with --shard K/N; what all the shards write is what one run
+// writes, file for file and byte for byte.
+TEST_F(ConvertCli, ShardsTogetherWriteWhatOneRunWrites) {
+  TempDir dir;
+  std::vector<std::string> inputs;
+  for (const char* name : {"a", "b", "c"}) {
+    make_frames(dir / "in" / name, {"0.png", "1.png"});
+    inputs.push_back((dir / "in" / name).string());
+  }
+  // Two inputs with the same name get the suffixes of the whole run in every shard.
+  make_frames(dir / "in" / "again" / "a", {"0.png", "1.png"});
+  inputs.push_back((dir / "in" / "again" / "a").string());
+
+  ASSERT_EQ(convert(dir / "whole", inputs).exit_code, 0);
+  for (const char* shard : {"0/3", "1/3", "2/3"}) {
+    auto args = inputs;
+    args.insert(args.end(), {"--shard", shard});
+    const auto result = convert(dir / "sharded", args);
+    ASSERT_EQ(result.exit_code, 0) << shard << ": " << result.output;
+  }
+  const auto whole = tree(dir / "whole"), sharded = tree(dir / "sharded");
+  EXPECT_EQ(whole.size(), 8u);  // 4 inputs × (1 flow + index.csv)
+  EXPECT_TRUE(whole.count("a_2/0.flo")) << "the second 'a' is a_2";
+  EXPECT_TRUE(whole == sharded) << "the shards wrote other files than the whole run";
+
+  for (const char* bad : {"3/3", "1/0", "-1/2", "1", "a/b"}) {
+    auto args = inputs;
+    args.insert(args.end(), {"--shard", bad});
+    EXPECT_EQ(convert(dir / "bad", args).exit_code, kExitUsage) << bad;
+  }
+}
+
+TEST(ConvertFrameRate, ImagesNamedByTheirCaptureTimeGiveTheirRate) {
+  // The fixture camera's names: nanoseconds since the epoch, about 66.7 ms apart.
+  const auto rate = rate_from_timestamps({"1684437740861809471", "1684437740927818192", "1684437740994402386",
+                                          "1684437741060823325"});
+  ASSERT_TRUE(rate.known());
+  EXPECT_NEAR(rate.fps(), 15.1, 0.05);
+  EXPECT_NEAR(rate_from_timestamps({"1700000000000", "1700000000040", "1700000000080"}).fps(), 25.0, 1e-9);  // ms
+  EXPECT_NEAR(rate_from_timestamps({"1700000000", "1700000002"}).fps(), 0.5, 1e-9);                        // s
+  for (const std::vector<std::string>& none :
+       {std::vector<std::string>{"frame_001", "frame_002"}, {"0001", "0002"}, {"1684437740861809471"},
+        {"1684437740927818192", "1684437740861809471"}, {"1700000000000", "17000000000400"}}) {
+    EXPECT_FALSE(rate_from_timestamps(none).known()) << none.front();
+  }
+}
+
+TEST_F(ConvertCli, VideoOfImagesPlaysAtTheirTimestampRateOrAtFps) {
+  TempDir dir;
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < 3; ++i) names.push_back(camera_frames_[i].filename().string());
+  make_frames(dir / "camera", names);
+  ASSERT_EQ(convert(dir / "out", {(dir / "camera").string(), "--viz", "video"}).exit_code, 0);
+  {
+    pipeline::VideoDecoder decoder((dir / "out" / "camera" / "viz.mp4").string());
+    while (decoder.next()) {
+    }
+    EXPECT_NEAR(decoder.frame_rate().fps(), 15.1, 0.1) << "the fixture camera runs at about 15 fps";
+  }
+  ASSERT_EQ(convert(dir / "fps", {(dir / "camera").string(), "--viz", "video", "--fps", "25"}).exit_code, 0);
+  pipeline::VideoDecoder decoder((dir / "fps" / "camera" / "viz.mp4").string());
+  while (decoder.next()) {
+  }
+  EXPECT_EQ(decoder.frame_rate().numerator, 25);
+  EXPECT_EQ(convert(dir / "bad", {(dir / "camera").string(), "--fps", "0"}).exit_code, kExitUsage);
 }
 
 }  // namespace

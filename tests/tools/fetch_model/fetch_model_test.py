@@ -170,6 +170,8 @@ class Case:
 
     def check_nothing_left(self):
         check(self.out_entries() == [], f"the output directory must stay empty, holds {self.out_entries()}")
+        # A folder fetch-model created for the download goes too (out/ did not exist before).
+        check(not self.out.exists(), f"{self.out} was created for a failed download and left behind")
 
     def check_fetched(self, result):
         check(result.returncode == 0, f"expected success, got exit {result.returncode}")
@@ -213,6 +215,8 @@ def case_offline(c: Case):
     check(result.returncode == 69, f"a refused connection must exit 69, got {result.returncode}")
     check(f"could not connect to 127.0.0.1:{port}" in result.stderr, "the message must say it could not connect")
     check("offline?" in result.stderr, "the message must suggest the machine may be offline")
+    check("copied by hand" in result.stderr and str(c.out / FILE) in result.stderr,
+          "the message must say the file can be copied into place by hand")
     c.check_nothing_left()
 
 

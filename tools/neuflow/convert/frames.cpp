@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cmath>
+#include <cctype>
 #include <filesystem>
 #include <map>
 #include <utility>
@@ -48,7 +50,11 @@ class ImageSequence final : public FrameSource {
   }
 
   std::optional<std::int64_t> frame_count() const override { return static_cast<std::int64_t>(files_.size()); }
-  pipeline::FrameRate frame_rate() const override { return {}; }
+  pipeline::FrameRate frame_rate() const override {
+    std::vector<std::string> stems;
+    for (const auto& file : files_) stems.push_back(file.path.stem().string());
+    return rate_from_timestamps(stems);
+  }
 
  private:
   std::vector<ImageFile> files_;
@@ -119,6 +125,36 @@ std::vector<fs::path> list_images(const fs::path& folder) {
 }
 
 }  // namespace
+
+pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems) {
+  if (stems.size() < 2) return {};
+  const std::size_t digits = stems.front().size();
+  double unit = 0;  // seconds per tick
+  switch (digits) {
+    case 10: unit = 1; break;
+    case 13: unit = 1e-3; break;
+    case 16: unit = 1e-6; break;
+    case 19: unit = 1e-9; break;
+    default: return {};
+  }
+  std::uint64_t previous = 0;
+  std::uint64_t first = 0;
+  for (std::size_t i = 0; i < stems.size(); ++i) {
+    const std::string& stem = stems[i];
+    if (stem.size() != digits ||
+        !std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) {
+      return {};
+    }
+    const std::uint64_t t = std::stoull(stem);
+    if (i > 0 && t <= previous) return {};
+    if (i == 0) first = t;
+    previous = t;
+  }
+  const double seconds = static_cast<double>(previous - first) * unit;
+  const double fps = static_cast<double>(stems.size() - 1) / seconds;
+  if (!(fps > 0) || fps > 1000) return {};
+  return {static_cast<int>(std::lround(fps * 1000)), 1000};
+}
 
 std::unique_ptr<FrameSource> open_frames(const InputSpec& input) {
   if (input.rejected) throw *input.rejected;

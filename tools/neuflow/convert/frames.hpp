@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "convert/inputs.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -35,6 +36,12 @@ class FrameSource {
   // The rate for an encoded visualization; unknown for images.
   virtual pipeline::FrameRate frame_rate() const = 0;
 };
+
+// The frame rate that images named by their capture time imply: every name all digits, of one
+// length, 10 (seconds), 13 (ms), 16 (µs) or 19 (ns since the epoch) digits, strictly
+// increasing; the mean rate over the sequence, in thousandths of a frame per second. Unknown
+// for anything else and for fewer than two images.
+pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems);
 
 // Throws InputError when the input cannot be opened (missing, an empty folder…).
 std::unique_ptr<FrameSource> open_frames(const InputSpec& input);

@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Image folders have no frame rate; this one plays a visualization at a watchable pace.
+// Images without timestamps in their names have no frame rate; this one plays a
+// visualization at a watchable pace.
 constexpr pipeline::FrameRate kImageSequenceRate{10, 1};
 
 const char* extension_of(flow::FlowFormat format) {
@@ -196,7 +197,8 @@ void Conversion::render(const flow::FlowField& field, const std::string& stem, b
     return;
   }
   if (!video_) {
-    const auto rate = frames_->frame_rate();
+    pipeline::FrameRate rate = frames_->frame_rate();
+    if (input_.kind != InputKind::video && settings_.image_rate) rate = *settings_.image_rate;
     video_ = std::make_unique<pipeline::VideoEncoder>(dir_ / "viz.mp4", image.width, image.height,
                                                       rate.known() ? rate : kImageSequenceRate);
   }

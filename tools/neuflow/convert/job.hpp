@@ -16,6 +16,7 @@
 
 #include "convert/input_error.hpp"
 #include "convert/inputs.hpp"
+#include "neuflow/pipeline/frame_rate.hpp"
 #include "convert/progress.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -31,6 +32,9 @@ struct ConvertSettings {
   double max_flow = 20;  // px at full saturation, fixed so colours mean the same in every frame
   bool resume = false;   // keep flow files that exist and read back at the right size
   std::int64_t max_frames = 0;  // 0: every frame; else only the first max_frames of each input
+  // The rate of viz.mp4 for images (a video keeps its own): unset, the rate the file names'
+  // timestamps give, else 10 frames per second.
+  std::optional<pipeline::FrameRate> image_rate;
 };
 
 struct InputOutcome {

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 #include <optional>
+#include <vector>
 
 #include "fetch_model/error.hpp"
 #include "fetch_model/hash.hpp"
@@ -111,6 +112,41 @@ class TempFile {
   bool committed_ = false;
 };
 
+// Creates the destination's missing folders; unless keep() is called, the destructor removes
+// the ones it created (when they are still empty), so a failed download leaves nothing behind.
+class CreatedDirectories {
+ public:
+  explicit CreatedDirectories(const fs::path& dir) {
+    if (dir.empty()) return;
+    std::error_code ec;
+    for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+      created_.push_back(p);
+      if (p == p.parent_path()) break;
+    }
+    fs::create_directories(dir, ec);
+    if (ec) {
+      remove_created();
+      throw FetchError(Kind::kLocalIo, "cannot create the directory " + dir.string() + ": " + ec.message());
+    }
+  }
+  ~CreatedDirectories() {
+    if (!kept_) remove_created();
+  }
+  CreatedDirectories(const CreatedDirectories&) = delete;
+  CreatedDirectories& operator=(const CreatedDirectories&) = delete;
+
+  void keep() { kept_ = true; }
+
+ private:
+  void remove_created() {
+    std::error_code ec;
+    for (const auto& p : created_) fs::remove(p, ec);  // deepest first; only empty folders go
+  }
+
+  std::vector<fs::path> created_;  // deepest first
+  bool kept_ = false;
+};
+
 // Writes the body to the temporary file and hashes it on the way, so the file is never
 // read back — except when the server sends no Content-Length, which the git hash needs first.
 class VerifyingSink : public HttpBodySink {
@@ -193,14 +229,7 @@ FetchResult fetch_model(const FetchRequest& request) {
   const std::string expected = lowercase(request.expected_sha1);
   if (already_present(request, expected)) return {false, fs::file_size(request.destination), expected};
 
-  if (request.destination.has_parent_path()) {
-    std::error_code ec;
-    fs::create_directories(request.destination.parent_path(), ec);
-    if (ec) {
-      throw FetchError(Kind::kLocalIo, "cannot create the directory " + request.destination.parent_path().string() +
-                                           ": " + ec.message());
-    }
-  }
+  CreatedDirectories created(request.destination.has_parent_path() ? request.destination.parent_path() : fs::path());
 
   TempFile file(request.destination);
   VerifyingSink sink(file, request.url);
@@ -213,6 +242,7 @@ FetchResult fetch_model(const FetchRequest& request) {
   }
   if (request.accept) request.accept(file.path());
   file.commit(request.destination);
+  created.keep();
   return {true, sink.received(), expected};
 }
 
