@@ -95,7 +95,7 @@ Config parse_config(const std::string& text, const std::filesystem::path& file, 
   std::vector<ConfigIssue> warnings;
   if (checks == ConfigChecks::all) {
     Issues machine(file);
-    check_machine(result.needs, installed_gstreamer(), machine);
+    check_machine(result.needs, installed_gstreamer(), machine, issues);
     warnings = machine.take_sorted();
     for (auto& warning : warnings) warning.severity = ConfigIssue::Severity::warning;
   }

@@ -8,15 +8,18 @@
 #include <cerrno>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <set>
+#include <string>
 
+#include "neuflow/model/architecture.hpp"
+#include "neuflow/model/checkpoint.hpp"
 
 namespace neuflow::daemon {
 namespace {
 
 // The elements of this project's plugin (libgstneuflow.so).
 bool is_neuflow_element(const std::string& factory) { return factory.starts_with("neuflow"); }
-
 
 namespace fs = std::filesystem;
 
@@ -59,6 +62,24 @@ void check_readable_file(const PathNeed& need, Issues& issues) {
   const int fd = ::open(need.path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return report(need, issues, std::string("cannot be read by this user: ") + std::strerror(errno));
   ::close(fd);
+}
+
+// Readable (else a warning), then the checkpoint reader's container, pickle and storage-size
+// checks and the architecture check, without reading the weights (36 MB).
+void check_checkpoint(const PathNeed& need, Issues& issues, Issues& errors) {
+  const std::size_t before = issues.size();
+  check_readable_file(need, issues);
+  if (issues.size() != before) return;
+  std::optional<std::string> problem;
+  try {
+    problem = model::find_architecture_mismatch(model::read_checkpoint_header(need.path));
+  } catch (const model::CheckpointError& e) {
+    // The loader names the file; the message names it already.
+    std::string what = e.what();
+    if (const auto colon = what.find("': "); colon != std::string::npos) what.erase(0, colon + 3);
+    problem = what;
+  }
+  if (problem) report(need, errors, "is not a NeuFlow-V2 checkpoint: " + *problem);
 }
 
 void check_video_device(const PathNeed& need, Issues& issues) {
@@ -190,11 +211,14 @@ GstInventory installed_gstreamer() {
   };
 }
 
-void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Issues& issues) {
+void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Issues& issues, Issues& errors) {
   for (const auto& need : needs.paths) {
     switch (need.kind) {
       case PathNeed::Kind::readable_file:
         check_readable_file(need, issues);
+        break;
+      case PathNeed::Kind::checkpoint:
+        check_checkpoint(need, issues, errors);
         break;
       case PathNeed::Kind::video_device:
         check_video_device(need, issues);

@@ -20,6 +20,12 @@ struct GstInventory {
 // The real registry. gst_init() must have been called.
 GstInventory installed_gstreamer();
 
-void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Issues& issues);
+// What the machine lacks now goes to `issues` (warnings: the daemon waits for it); a model
+// file that exists but is no NeuFlow-V2 checkpoint goes to `errors`, since waiting will not
+// change it.
+void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Issues& issues, Issues& errors);
+inline void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Issues& issues) {
+  check_machine(needs, gstreamer, issues, issues);
+}
 
 }  // namespace neuflow::daemon

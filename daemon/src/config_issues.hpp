@@ -22,6 +22,7 @@ class Issues {
     for (auto& issue : more) issues_.push_back(std::move(issue));
   }
   bool empty() const { return issues_.empty(); }
+  std::size_t size() const { return issues_.size(); }
   const std::filesystem::path& file() const { return file_; }
 
   // In the order of the file (tables are iterated by key name, not by position); issues about

@@ -18,7 +18,8 @@ namespace neuflow::daemon {
 
 struct PathNeed {
   enum class Kind {
-    readable_file,       // the model, an input video
+    readable_file,       // an input video, a credentials file
+    checkpoint,          // the model: readable, and a NeuFlow-V2 checkpoint
     video_device,        // a V4L2 device node
     writable_directory,  // exists and is writable, or can be created
   };

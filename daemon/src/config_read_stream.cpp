@@ -28,7 +28,7 @@ FlowConfig read_flow(const TableReader& t, ReadContext& context) {
     if (model->empty()) {
       t.report("model", "expected the path of a NeuFlow-V2 checkpoint (.pth), got an empty string");
     } else {
-      f.model = context.need_path(PathNeed::Kind::readable_file, *model, "model", t.position("model"));
+      f.model = context.need_path(PathNeed::Kind::checkpoint, *model, "model", t.position("model"));
     }
   }
   if (auto v = t.integer("iters-s16", 0, SessionLimits::max_iterations_s16)) f.iters_s16 = static_cast<int>(*v);

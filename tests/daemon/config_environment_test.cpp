@@ -16,6 +16,7 @@
 
 #include "config.hpp"
 #include "config_read.hpp"
+#include "checkpoint_builder.hpp"
 #include "config_test_util.hpp"
 
 namespace neuflow::daemon {
@@ -45,6 +46,9 @@ std::vector<ConfigIssue> machine_issues(const std::string& text, const GstInvent
 
 void write_file(const fs::path& path, const std::string& content = "x") { std::ofstream(path) << content; }
 
+// A small file with NeuFlow-V2's tensors and shapes, which passes the checkpoint check.
+void write_model(const fs::path& path) { neuflow::test::fake_neuflow_checkpoint().write(path); }
+
 bool running_as_root() { return ::geteuid() == 0; }
 
 // A stream with the given source and sinks, and a model path.
@@ -65,7 +69,7 @@ TEST(ConfigMachine, PluginElementsAreFoundFromTheBuildTree) {
 TEST(ConfigMachine, AValidSetupPasses) {
   TempFolder folder;
   fs::create_directory(folder / "models");
-  write_file(folder / "models/m.pth");
+  write_model(folder / "models/m.pth");
   write_file(folder / "in.mp4");
   const std::string text = stream("{ type = \"uri\", path = \"in.mp4\" }", "models/m.pth", R"(
   [[stream.sink]]
@@ -112,9 +116,40 @@ TEST(ConfigMachine, ModelMustBeAReadableFile) {
   }
 }
 
+// A file that is there but is no NeuFlow-V2 checkpoint will not become one by waiting: an
+// error (--check-config exits 78), found from the header alone.
+TEST(ConfigMachine, ModelMustBeANeuflowV2Checkpoint) {
+  TempFolder folder;
+  const fs::path file = folder / "neuflowd.toml";
+  const std::string sink = "sink = [ { type = \"display\" } ]\n";
+  const auto all = inventory_without({});
+  write_file(folder / "passwd", "root:x:0:0:root:/root:/bin/bash\n");
+  auto issues = machine_issues(stream("{ type = \"test\" }", "passwd", sink), all, file);
+  ASSERT_EQ(issues.size(), 1u) << test::listed(issues);
+  EXPECT_TRUE(has_issue(issues, 4, 18, "is not a NeuFlow-V2 checkpoint: not a PyTorch checkpoint"));
+
+  auto other = neuflow::test::fake_neuflow_checkpoint();
+  other.tensors.pop_back();  // upsample_s8.conv3.bias missing
+  other.write(folder / "other.pth");
+  issues = machine_issues(stream("{ type = \"test\" }", "other.pth", sink), all, file);
+  ASSERT_EQ(issues.size(), 1u) << test::listed(issues);
+  EXPECT_TRUE(has_issue(issues, 4, 18, "is not a NeuFlow-V2 checkpoint: missing tensor 'upsample_s8.conv3.bias'"));
+
+  // Through the loader: an error, not a warning.
+  write_file(folder / "passwd.toml", stream("{ type = \"test\" }", "passwd", sink));
+  try {
+    load_config(folder / "passwd.toml");
+    ADD_FAILURE() << "a config whose model is no checkpoint loaded";
+  } catch (const ConfigError& e) {
+    std::size_t errors = 0;
+    for (const auto& issue : e.issues()) errors += issue.is_warning() ? 0 : 1;
+    EXPECT_EQ(errors, 1u) << e.what();
+  }
+}
+
 TEST(ConfigMachine, V4l2DeviceMustBeACharacterDevice) {
   TempFolder folder;
-  write_file(folder / "m.pth");
+  write_model(folder / "m.pth");
   write_file(folder / "video9");
   const std::string model = (folder / "m.pth").string();
   const std::string sink = "sink = [ { type = \"display\" } ]\n";
@@ -143,7 +178,7 @@ TEST(ConfigMachine, V4l2DeviceMustBeACharacterDevice) {
 
 TEST(ConfigMachine, InputFilesMustExist) {
   TempFolder folder;
-  write_file(folder / "m.pth");
+  write_model(folder / "m.pth");
   const std::string model = (folder / "m.pth").string();
   const std::string sink = "sink = [ { type = \"display\" } ]\n";
   const auto all = inventory_without({});
@@ -167,7 +202,7 @@ TEST(ConfigMachine, InputFilesMustExist) {
 
 TEST(ConfigMachine, OutputFoldersMustExistOrBeCreatable) {
   TempFolder folder;
-  write_file(folder / "m.pth");
+  write_model(folder / "m.pth");
   write_file(folder / "plain-file");
   const std::string model = (folder / "m.pth").string();
   const auto all = inventory_without({});
@@ -230,7 +265,7 @@ TEST(ConfigMachine, MissingNeuflowPluginIsReportedOnceWithWhatToDo) {
 
 TEST(ConfigMachine, MissingElementsNameTheirUsersAndPackage) {
   TempFolder folder;
-  write_file(folder / "m.pth");
+  write_model(folder / "m.pth");
   const std::string text = stream("{ type = \"libcamera\" }", (folder / "m.pth").string(),
                                   "sink = [ { type = \"video\", udp = \"127.0.0.1:5000\" },\n"
                                   "         { type = \"video\", name = \"rec\", file = \"" +

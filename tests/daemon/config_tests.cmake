@@ -11,7 +11,7 @@ target_compile_definitions(neuflowd_config_tests PRIVATE NEUFLOW_CONFIG_DIR="${P
 if(TARGET neuflow_gst_test_main)
   add_executable(neuflowd_config_machine_tests config_environment_test.cpp)
   target_link_libraries(neuflowd_config_machine_tests PRIVATE neuflowd_core neuflow_gst_test_main
-                        neuflow_test_support GTest::gtest neuflow::options)
+                        neuflow_test_support neuflow_test_checkpoints GTest::gtest neuflow::options)
   set_target_properties(neuflowd_config_machine_tests PROPERTIES NEUFLOW_GLIB_MACROS ON)
   include(NeuflowGstTestEnv)
   neuflow_gst_test_env(neuflowd_config_env)

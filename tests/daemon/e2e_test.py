@@ -485,6 +485,13 @@ class CheckConfig(DaemonTestCase):
         # The offending line follows, with a caret under the key.
         self.assertRegex(out.stderr, r'\n    +colour = "red"\n +\^\n')
 
+    def test_a_model_that_is_no_checkpoint_is_an_error(self):
+        text = stream_block("wrong", test_source(), ['  type = "files"\n  directory = "%s"' %
+                                                     os.path.join(self.dir, "x")]).replace(CHECKPOINT, "/etc/passwd")
+        out, _ = self.run_check(text)
+        self.assertEqual(out.returncode, 78, out.stderr)
+        self.assertIn('model: "/etc/passwd" is not a NeuFlow-V2 checkpoint', out.stderr)
+
     def test_unknown_choice_offers_the_closest_value(self):
         text = stream_block("typo", test_source(), ['  type = "fiels"\n  directory = "%s"' % os.path.join(self.dir, "x")])
         out, _ = self.run_check(text)

@@ -35,6 +35,7 @@ foreach(test_case
     CheckConfig.test_valid_config_passes
     CheckConfig.test_errors_name_line_and_exit_78
     CheckConfig.test_unknown_choice_offers_the_closest_value
+    CheckConfig.test_a_model_that_is_no_checkpoint_is_an_error
     CheckConfig.test_missing_model_is_a_warning_and_the_stream_waits_for_it
     DaemonReliability.test_missing_camera_and_input_file_leave_the_other_streams_running
     DaemonReliability.test_a_sink_that_cannot_be_built_is_cut_off_at_start

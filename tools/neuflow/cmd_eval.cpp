@@ -16,6 +16,7 @@
 #include "neuflow/eval/evaluate.hpp"
 #include "neuflow/eval/layouts.hpp"
 #include "neuflow/eval/model_predictor.hpp"
+#include "neuflow/eval/pair_figure.hpp"
 #include "neuflow/eval/prediction_files.hpp"
 #include "neuflow/eval/report.hpp"
 #include "neuflow/flow/errors.hpp"
@@ -31,6 +32,8 @@ struct EvalArgs {
   std::string pass = "both";
   bool per_sequence = false;
   std::size_t max_pairs = 0;
+  std::string save_viz;  // --save-viz DIR
+  std::string plot;      // --plot FILE.svg
   SessionArgs session;
 };
 
@@ -132,6 +135,22 @@ void run(const EvalArgs& a) {
   eval::EvaluateOptions options;
   options.max_pairs = a.max_pairs;
   options.progress = ProgressPrinter();
+  if (!a.save_viz.empty()) {
+    const std::filesystem::path dir = a.save_viz;
+    options.on_pair = [dir](const eval::EvalSet& set, const eval::Pair& pair, const flow::FlowField& predicted,
+                            const flow::FlowField& ground_truth) {
+      // DIR/<set>/<pair key>.png: the key is the first image's path in the layout.
+      const std::filesystem::path file = dir / set.name / (pair.key + ".png");
+      std::error_code ec;
+      std::filesystem::create_directories(file.parent_path(), ec);
+      if (ec) throw CommandError(kExitCantCreate, "eval: " + file.parent_path().string() + ": " + ec.message());
+      try {
+        eval::write_pair_figure(predicted, ground_truth, file);
+      } catch (const flow::FlowFileError& e) {
+        throw CommandError(kExitCantCreate, std::string("eval: --save-viz: ") + e.what());
+      }
+    };
+  }
   std::vector<eval::SetResult> results;
   for (const auto& set : sets) results.push_back(eval::evaluate_set(set, source, options));
 
@@ -148,6 +167,13 @@ void run(const EvalArgs& a) {
     run.network_order = session.network_order;
     run.max_pairs = a.max_pairs;
     write_json(a.json, eval::format_json(run, results, a.per_sequence));
+  }
+  if (!a.plot.empty()) {
+    try {
+      eval::write_epe_plot(results, a.plot);
+    } catch (const std::runtime_error& e) {
+      throw CommandError(kExitCantCreate, std::string("eval: --plot: ") + e.what());
+    }
   }
 }
 
@@ -181,6 +207,16 @@ void register_eval(CLI::App& app) {
       ->check(CLI::IsMember({"clean", "final", "both"}));
   cmd->add_option("--json", a->json, "Also write the results as JSON to FILE ('-': stdout)");
   cmd->add_flag("--per-sequence", a->per_sequence, "Break the results down by sequence");
+  cmd->add_option("--save-viz", a->save_viz,
+                  "Also write one PNG per pair to DIR/<set>/<pair>.png: prediction, ground truth (one colour "
+                  "scale: the ground truth's largest vector) and end-point error (white: the pair's largest)");
+  cmd->add_option("--plot", a->plot, "Also write a bar chart of the EPE per sequence to FILE (SVG)")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            return value.size() > 4 && value.substr(value.size() - 4) == ".svg" ? std::string()
+                                                                                : "--plot writes SVG: FILE.svg";
+          },
+          "FILE.svg"));
   cmd->add_option("--max-pairs", a->max_pairs, "Score only the first N pairs of each set (default: all)")
       ->check(CLI::PositiveNumber);
   // The reference evaluation pads each pair itself, so no model size is offered here.

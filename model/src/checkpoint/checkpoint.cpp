@@ -100,7 +100,9 @@ struct Storage {
 
 class Loader {
  public:
-  explicit Loader(const std::filesystem::path& path) : path_(path) {}
+  // Without data, every tensor gets its shape and dtype and each storage's size is checked
+  // against the zip entry, but no tensor data is read.
+  Loader(const std::filesystem::path& path, bool with_data) : path_(path), with_data_(with_data) {}
 
   Checkpoint load() {
     check_file();
@@ -149,7 +151,7 @@ class Loader {
 
     for (auto& [key, ref] : entries) {
       if (all_prefixed) key.erase(0, kPrefix.size());
-      CheckpointTensor tensor = materialize(zip, folder, key, *ref);
+      CheckpointTensor tensor = with_data_ ? materialize(zip, folder, key, *ref) : describe(zip, folder, *ref);
       // A repeated key replaces the earlier value (Python dict semantics); order stays first-seen.
       const auto [it, inserted] = checkpoint.tensors.insert_or_assign(key, std::move(tensor));
       if (inserted) checkpoint.keys.push_back(key);
@@ -239,6 +241,21 @@ class Loader {
     }
     wrapper = "bare";
     return *top;
+  }
+
+  CheckpointTensor describe(const detail::ZipArchive& zip, const std::string& folder, const TensorRef& ref) const {
+    const StorageRef& sref = *ref.storage;
+    const std::string entry = folder + "data/" + sref.key;
+    const auto size = zip.size_of(entry);
+    if (!size) fail(Kind::kFormat, "zip entry '" + entry + "' (storage " + sref.key + ") is missing");
+    if (static_cast<uint64_t>(sref.numel) > *size / detail::dtype_size(sref.dtype)) {
+      fail(Kind::kFormat, "storage '" + sref.key + "' declares " + std::to_string(sref.numel) + " elements but '" +
+                              entry + "' holds only " + std::to_string(*size) + " bytes");
+    }
+    CheckpointTensor tensor;
+    tensor.shape = ref.size;
+    tensor.dtype = detail::dtype_name(sref.dtype);
+    return tensor;
   }
 
   const Storage& storage(const detail::ZipArchive& zip, const std::string& folder,
@@ -348,6 +365,7 @@ class Loader {
   }
 
   std::filesystem::path path_;
+  bool with_data_ = true;
   bool big_endian_ = false;
   std::unordered_map<std::string, Storage> storages_;
 };
@@ -372,7 +390,17 @@ const CheckpointTensor& Checkpoint::at(const std::string& key) const {
 
 Checkpoint load_checkpoint(const std::filesystem::path& path) {
   try {
-    return Loader(path).load();
+    return Loader(path, true).load();
+  } catch (const CheckpointError& e) {
+    throw CheckpointError(e.kind(), "checkpoint '" + path.string() + "': " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw CheckpointError(Kind::kFormat, "checkpoint '" + path.string() + "': out of memory");
+  }
+}
+
+Checkpoint read_checkpoint_header(const std::filesystem::path& path) {
+  try {
+    return Loader(path, false).load();
   } catch (const CheckpointError& e) {
     throw CheckpointError(e.kind(), "checkpoint '" + path.string() + "': " + e.what());
   } catch (const std::bad_alloc&) {

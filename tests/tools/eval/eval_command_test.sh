@@ -104,6 +104,26 @@ expect_stderr '^kitti +1 +0\.000 +0\.00% +100\.00%'  # the table moves to stderr
 
 run_expect 0 --dataset middlebury "$M" --predictions "$P/middlebury" --max-pairs 1
 expect_stdout '^middlebury +1 +0\.000 '
+
+# Pictures: one PNG per pair (prediction | ground truth | error, side by side) and an SVG of
+# the EPE per sequence.
+run_expect 0 --dataset kitti "$K" --predictions "$P/kitti" --save-viz "$work/viz" --plot "$work/epe.svg"
+"$python" - "$work/viz" "$work/epe.svg" <<'PY' || fail "--save-viz / --plot output"
+import sys, os, struct, xml.etree.ElementTree as ET
+viz, svg = sys.argv[1:]
+pngs = [os.path.join(d, f) for d, _, fs in os.walk(viz) for f in fs]
+assert len(pngs) == 1 and pngs[0].endswith("kitti/image_2/000000_10.png"), pngs
+with open(pngs[0], "rb") as f:
+    head = f.read(24)
+assert head[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+width, height = struct.unpack(">II", head[16:24])
+assert (width, height) == (3 * 1242 + 8, 375), (width, height)
+root = ET.parse(svg).getroot()
+texts = [t.text for t in root.iter("{http://www.w3.org/2000/svg}text")]
+assert any(t and t.startswith("kitti: EPE 0.000") for t in texts), texts
+assert len(list(root.iter("{http://www.w3.org/2000/svg}rect"))) == 2, "background and one bar"
+PY
+run_expect 64 --dataset kitti "$K" --predictions "$P/kitti" --plot "$work/epe.png"
 run_expect 0 --dataset chairs "$C/data" --predictions "$P/chairs" --pass final
 expect_stdout '^chairs +1 +0\.000 '
 run_expect 0 --dataset sintel "$work/Sintel/training" --predictions "$P/sintel" --pass final

@@ -30,6 +30,7 @@ SetResult evaluate_set(const EvalSet& set, const FlowSource& source, const Evalu
     }
     const flow::FlowMetrics metrics = flow::compute_metrics(predicted, ground_truth);
     overall.add(metrics);
+    if (options.on_pair) options.on_pair(set, pair, predicted, ground_truth);
     // Pairs of a sequence are adjacent, so the last name is the one to check first.
     auto it = std::find(sequence_names.rbegin(), sequence_names.rend(), pair.sequence);
     if (it == sequence_names.rend()) {

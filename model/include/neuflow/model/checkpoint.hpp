@@ -75,4 +75,9 @@ std::string shape_text(const std::vector<int64_t>& shape);
 // Reads a checkpoint completely (all tensors, converted to float32). Throws CheckpointError.
 Checkpoint load_checkpoint(const std::filesystem::path& path);
 
+// The same checks of the container and the pickle, and of each storage's size, but no tensor
+// data is read: every tensor has its shape and dtype and empty data. For checking that a
+// file is a NeuFlow-V2 checkpoint (find_architecture_mismatch) without loading 36 MB.
+Checkpoint read_checkpoint_header(const std::filesystem::path& path);
+
 }  // namespace neuflow::model

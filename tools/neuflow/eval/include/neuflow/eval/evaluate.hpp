@@ -39,6 +39,10 @@ struct EvalProgress {
 struct EvaluateOptions {
   std::size_t max_pairs = 0;  // score only the first N pairs of the set; 0: all
   std::function<void(const EvalProgress&)> progress;  // after every pair, if set
+  // Every pair's prediction and ground truth once scored (--save-viz), if set.
+  std::function<void(const EvalSet&, const Pair&, const flow::FlowField& predicted,
+                     const flow::FlowField& ground_truth)>
+      on_pair;
 };
 
 // Throws what the source and the ground-truth reader throw (EvalError, flow::FlowFileError,
