@@ -24,6 +24,7 @@ packages=(
   systemd                           # systemd-analyze verify of the unit files
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev libomp-14-dev llvm-14   # libFuzzer harnesses (tests/fuzz), llvm-symbolizer
+  g++-11                            # JetPack 6's compiler: CI compiles the core with it
   python3 python3-numpy             # tests check that numpy reads our .npy files
 )
 

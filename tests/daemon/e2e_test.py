@@ -112,6 +112,15 @@ class Daemon:
         with open(self.log_path) as f:
             return f.read()
 
+    def wait_ready(self, timeout=60):
+        """READY=1 from the daemon; on a timeout the failure shows the daemon's log and exit status."""
+        try:
+            return self.notify.wait_for("READY=1", timeout=timeout)
+        except AssertionError as e:
+            status = self.proc.poll()
+            raise AssertionError(f"{e}\nneuflowd {'exited ' + str(status) if status is not None else 'still runs'}; "
+                                 f"its log:\n{self.log_text()[-4000:]}") from None
+
     def wait_log(self, pattern, timeout):
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -243,7 +252,7 @@ class DaemonLifecycle(DaemonTestCase):
                               [f'  type = "files"\n  directory = "{clip_dir}"'], behaviour="every-pair"))
 
         d = self.start(config(files_b))
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
 
         # The file stream converts every pair and finishes; the live one keeps producing.
         d.wait_log(r"stream clip: end of input", timeout=90)
@@ -267,7 +276,7 @@ class DaemonLifecycle(DaemonTestCase):
         d.rewrite(config(files_b2))
         d.proc.send_signal(signal.SIGHUP)
         d.notify.wait_for("RELOADING=1", timeout=30)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         d.wait_log(r"stream clip: end of input.*\n(.*\n)*.*stream clip: end of input", timeout=90)
         self.assertEqual(len(flow_files(files_b2)), 11)
         log = d.log_text()
@@ -295,7 +304,7 @@ class DaemonLifecycle(DaemonTestCase):
         d = self.start(stream_block("w", test_source(), ['  type = "files"\n  directory = "%s"' %
                                                          os.path.join(self.dir, "w")]),
                        extra_env={"WATCHDOG_USEC": "2000000"})
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         d.notify.wait_for("WATCHDOG=1", timeout=10)
         d.notify.wait_for("WATCHDOG=1", timeout=10)
         # STATUS= is sent when it changes: it may have come with READY=1 and not since (a stream
@@ -347,7 +356,7 @@ class DaemonVideoOut(DaemonTestCase):
             '  type = "video"\n  rtsp = "/cam"',
             f'  type = "video"\n  udp = "127.0.0.1:{udp_port}"',
         ]))
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         caps = "application/x-rtp,media=video,encoding-name=H264,payload=96,clock-rate=90000"
         udp = subprocess.run([os.environ["GST_LAUNCH"], "-q", "udpsrc", f"port={udp_port}", f"caps={caps}", "!",
                               "rtph264depay", "!", "avdec_h264", "!", "video/x-raw,width=64,height=48", "!",
@@ -370,7 +379,7 @@ class DaemonVideoOut(DaemonTestCase):
         os.chmod(users, 0o600)
         d = self.start(f'[rtsp]\nlisten = "127.0.0.1:{rtsp_port}"\ncredentials = "{users}"\n' +
                        stream_block("cam", test_source(), ['  type = "video"\n  rtsp = "/cam"']))
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         d.wait_log(r"rtsp: 1 user from .*rtsp-users \(digest authentication\)", timeout=10)
 
         def watch(*login):
@@ -407,7 +416,7 @@ class DaemonFailures(DaemonTestCase):
                              ['  type = "files"\n  directory = "%s"' % os.path.join(self.dir, "broken")]) +
                 stream_block("good", test_source(), [f'  type = "files"\n  directory = "{good}"']))
         d = self.start(text)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         d.wait_log(r"stream broken: .*restarting in", timeout=60)
         before = len(flow_files(good))
         d.wait_log(r"stream broken: .*restarting in(.*\n)+.*stream broken: .*restarting in", timeout=60)
@@ -442,7 +451,7 @@ class DaemonFailures(DaemonTestCase):
             f'  type = "files"\n  name = "doomed"\n  directory = "{doomed}"',
             f'  type = "files"\n  name = "kept"\n  directory = "{kept}"',
         ]))
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         deadline = time.monotonic() + 60
         while len(flow_files(doomed)) < 2 and time.monotonic() < deadline:
             time.sleep(0.2)
@@ -508,7 +517,7 @@ class CheckConfig(DaemonTestCase):
         self.assertRegex(out.stderr, r":\d+:\d+: warning: model: .*late\.pth.* does not exist")
         self.assertIn("1 warning", out.stdout)
         d = self.start(text)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         d.wait_log(r"warning: model: .*late\.pth", timeout=10)
         d.wait_log(r"stream late: .*restarting in", timeout=60)
         # The model arrives (fetch-model, a copy): the stream comes up by itself.
@@ -541,7 +550,7 @@ class DaemonReliability(DaemonTestCase):
         self.assertRegex(check.stderr, r"warning: path: .*arrives-later\.mp4")
 
         d = self.start(text)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         wait_until(lambda: len(flow_files(good)) >= 3, 60, "the good stream wrote no flows")
         d.wait_log(r"stream cam: .*restarting in", timeout=30)
         d.wait_log(r"stream late: .*restarting in", timeout=30)
@@ -549,7 +558,7 @@ class DaemonReliability(DaemonTestCase):
         # A reload while the camera is still missing is accepted.
         d.proc.send_signal(signal.SIGHUP)
         d.notify.wait_for("RELOADING=1", timeout=30)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         self.assertNotIn("the new config has errors", d.log_text())
 
         # The input file appears: its stream comes up and converts every pair.
@@ -569,7 +578,7 @@ class DaemonReliability(DaemonTestCase):
             '  type = "files"\n  name = "forbidden"\n  directory = "/proc/neuflow-forbidden"',
             f'  type = "files"\n  name = "kept"\n  directory = "{kept}"',
         ]))
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         d.wait_log(r"stream s: sink forbidden cannot be built: .*other sinks", timeout=30)
         wait_until(lambda: len(flow_files(kept)) >= 5, 60, "the healthy sink wrote no flows")
         self.assertNotIn("restarting in", d.log_text())
@@ -583,7 +592,7 @@ class DaemonReliability(DaemonTestCase):
                            f'  type = "files"\n  name = "a"\n  directory = "{files}"',
                            f'  type = "files"\n  name = "b"\n  directory = "{files}-b"']),
                        max_open_files=256)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         wait_until(lambda: len(flow_files(files)) >= 2, 60, "no flows")
         flood = []
         try:
@@ -618,7 +627,7 @@ class DaemonReliability(DaemonTestCase):
                         f'  type = "files"\n  directory = "{files}"\n  max-files = {max_files}']))
 
         d = self.start(config(20))
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         wait_until(lambda: len(flow_files(files)) >= 20, 60, "fewer than 20 flows")
         before = scrape(metrics_port)
         processed = metric(before, "neuflow_frames_processed_total", "s")
@@ -627,7 +636,7 @@ class DaemonReliability(DaemonTestCase):
         d.rewrite(config(10))
         d.proc.send_signal(signal.SIGHUP)
         d.notify.wait_for("RELOADING=1", timeout=30)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         d.wait_log(r"stream s: settings changed", timeout=10)
         d.wait_log(r"stream s: playing(.*\n)+.*stream s: playing", timeout=30)
         time.sleep(1.0)
@@ -658,7 +667,7 @@ class DaemonReliability(DaemonTestCase):
                 return int(next(l for l in f if l.startswith("VmRSS:")).split()[1]) / 1024
 
         d = self.start(config("a"))
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         wait_until(lambda: len(flow_files(os.path.join(self.dir, "a"))) >= 5, 60, "no flows")
         time.sleep(2)
         fresh = rss_mb(d.proc.pid)
@@ -666,7 +675,7 @@ class DaemonReliability(DaemonTestCase):
             d.rewrite(config("b" if i % 2 == 0 else "a"))
             d.proc.send_signal(signal.SIGHUP)
             time.sleep(1.5)
-        d.notify.wait_for("READY=1", timeout=60)
+        d.wait_ready(60)
         time.sleep(4)
         after = rss_mb(d.proc.pid)
         self.assertGreaterEqual(d.log_text().count("stream changes: settings changed"), 20)
