@@ -8,6 +8,7 @@ packages=(
   libdnnl-dev                       # oneDNN: convolutions and matrix products
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-video-dev
   libzip-dev                        # the zip container of PyTorch checkpoints
+  libpng-dev                        # flow/: KITTI flow PNGs and renderings
   libcli11-dev                      # command-line parsing
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer plugin
   gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-tools

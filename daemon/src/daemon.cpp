@@ -216,7 +216,7 @@ std::string Daemon::render_metrics() {
     m.flows = s.flows;
     m.uptime_s = s.state == StreamState::playing ? s.seconds_in_state : 0.0;
     for (const auto& sink : s.sinks) {
-      m.sinks.push_back({sink.name, sink.kind, sink.counts_flows, sink.flows_written, sink.failures});
+      m.sinks.push_back({sink.name, sink.kind, sink.counts_flows, sink.flows_written, sink.bytes_written, sink.failures});
     }
     all.push_back(std::move(m));
   }

@@ -159,6 +159,9 @@ std::string render_prometheus(const std::vector<StreamMetrics>& streams, double 
   };
   per_sink("neuflow_sink_flows_written_total", "Flows the sink wrote (flow files, or flows published into the ring).",
            true, [](const SinkMetrics& sink) { return sink.flows_written; });
+  per_sink("neuflow_sink_bytes_written_total",
+           "Bytes the sink wrote: the flow files' sizes, or the vectors published into the ring.", true,
+           [](const SinkMetrics& sink) { return sink.bytes_written; });
   per_sink("neuflow_sink_failures_total", "Times the sink failed or could not be built and was cut off.", false,
            [](const SinkMetrics& sink) { return sink.failures; });
   return out.take();

@@ -17,6 +17,7 @@ struct SinkMetrics {
   std::string kind;            // pipeline::sink_kind(): "files", "shm", "video-file", "rtsp", "udp", "display"
   bool counts_flows = false;   // files and shm sinks count what they write
   std::uint64_t flows_written = 0;
+  std::uint64_t bytes_written = 0;  // the flow files' sizes, or the vectors published
   std::uint64_t failures = 0;  // times it failed (or could not be built) and was cut off
 };
 

@@ -91,7 +91,7 @@ StreamTotals Stream::totals() const {
   const StreamSnapshot s = snapshot();
   StreamTotals t{s.frames_in, s.frames_processed, s.frames_dropped, s.flows, s.restarts, s.sink_failures,
                  s.inference, {}};
-  for (const auto& sink : s.sinks) t.sinks[sink.name] = {sink.flows_written, sink.failures};
+  for (const auto& sink : s.sinks) t.sinks[sink.name] = {sink.flows_written, sink.bytes_written, sink.failures};
   return t;
 }
 
@@ -200,7 +200,10 @@ void Stream::teardown() {
   base_.dropped += current_.dropped;
   base_.flows += current_.flows;
   current_ = {};
-  for (const auto& [sink, written] : sink_written_now_) sink_base_[sink].flows_written += written;
+  for (const auto& [sink, written] : sink_written_now_) {
+    sink_base_[sink].flows_written += written.flows_written;
+    sink_base_[sink].bytes_written += written.bytes_written;
+  }
   sink_written_now_.clear();
   if (bus_watch_) {
     g_source_remove(bus_watch_);
@@ -363,7 +366,10 @@ void Stream::read_counters() {
   current_.dropped = uint64_property(flow, "frames-dropped");
   current_.flows = uint64_property(flow, "flows");
   for (const auto& branch : graph_->sinks()) {
-    if (branch->writer) sink_written_now_[branch->name] = uint64_property(branch->writer, "flows-written");
+    if (branch->writer) {
+      sink_written_now_[branch->name] = {uint64_property(branch->writer, "flows-written"),
+                                         uint64_property(branch->writer, "bytes-written"), 0};
+    }
   }
   g_object_get(flow, "mean-latency", &latency_ms_, nullptr);
 }
@@ -421,9 +427,13 @@ StreamSnapshot Stream::snapshot() const {
     const auto base = sink_base_.find(sink.name);
     if (base != sink_base_.end()) {
       out.flows_written = base->second.flows_written;
+      out.bytes_written = base->second.bytes_written;
       out.failures = base->second.failures;
     }
-    if (const auto now = sink_written_now_.find(sink.name); now != sink_written_now_.end()) out.flows_written += now->second;
+    if (const auto now = sink_written_now_.find(sink.name); now != sink_written_now_.end()) {
+      out.flows_written += now->second.flows_written;
+      out.bytes_written += now->second.bytes_written;
+    }
     s.sinks.push_back(std::move(out));
   }
   s.seconds_in_state = seconds_since(state_since_);

@@ -46,6 +46,7 @@ struct StreamSnapshot {
     std::string kind;                  // pipeline::sink_kind()
     bool counts_flows = false;         // files and shm sinks count what they write
     std::uint64_t flows_written = 0;   // over all runs
+    std::uint64_t bytes_written = 0;
     std::uint64_t failures = 0;
   };
   std::vector<Sink> sinks;             // in config order
@@ -54,6 +55,7 @@ struct StreamSnapshot {
 // One sink's counts since the daemon started.
 struct SinkTotals {
   std::uint64_t flows_written = 0;
+  std::uint64_t bytes_written = 0;
   std::uint64_t failures = 0;
 };
 
@@ -147,7 +149,7 @@ class Stream {
   bool rate_known_ = false;           // a rate has been measured in this run
   // Per sink: what finished runs wrote (and failures), and what the running pipeline wrote.
   std::map<std::string, SinkTotals> sink_base_;
-  std::map<std::string, std::uint64_t> sink_written_now_;
+  std::map<std::string, SinkTotals> sink_written_now_;  // failures unused
   // Filled from the flow element's src pad (a streaming thread), read by scrapes.
   LatencyHistogram inference_;
   gulong inference_probe_ = 0;

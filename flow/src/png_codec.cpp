@@ -1,9 +1,13 @@
 #include "png_codec.hpp"
 
-#include <cstring>
-#include <string>
+#include <png.h>
 
-#include <opencv2/imgcodecs.hpp>
+#include <bit>
+#include <csetjmp>
+#include <cstring>
+#include <new>
+#include <string>
+#include <vector>
 
 #include "binary.hpp"
 #include "file_io.hpp"
@@ -60,29 +64,131 @@ PngHeader parse_png_header(std::span<const std::byte> bytes, const std::filesyst
   return h;
 }
 
-cv::Mat decode_png(std::span<const std::byte> bytes, const std::filesystem::path& path) {
-  cv::Mat image;
+namespace {
+
+// libpng reports errors through longjmp; these carry its message back. No exception crosses
+// libpng's C frames.
+void record_error(png_structp png, png_const_charp message) {
+  *static_cast<std::string*>(png_get_error_ptr(png)) = message ? message : "unknown libpng error";
+  png_longjmp(png, 1);
+}
+void ignore_warning(png_structp, png_const_charp) {}
+
+struct MemoryReader {
+  std::span<const std::byte> bytes;
+  std::size_t offset = 0;
+};
+
+void read_from_memory(png_structp png, png_bytep out, png_size_t length) {
+  auto* reader = static_cast<MemoryReader*>(png_get_io_ptr(png));
+  if (length > reader->bytes.size() - reader->offset) png_error(png, "truncated PNG data");
+  std::memcpy(out, reader->bytes.data() + reader->offset, length);
+  reader->offset += length;
+}
+
+void write_to_memory(png_structp png, png_bytep data, png_size_t length) {
+  auto* out = static_cast<std::vector<unsigned char>*>(png_get_io_ptr(png));
   try {
-    // imdecode only reads the buffer; the const_cast is for the Mat wrapper's signature.
-    const cv::Mat buffer(1, static_cast<int>(bytes.size()), CV_8UC1,
-                         const_cast<std::byte*>(bytes.data()));
-    image = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw FlowFileError(Kind::malformed, path, std::string("cannot decode PNG: ") + e.what());
+    out->insert(out->end(), data, data + length);
+  } catch (const std::bad_alloc&) {
+    png_error(png, "out of memory");
   }
-  if (image.empty()) throw FlowFileError(Kind::malformed, path, "cannot decode PNG (corrupt data?)");
+}
+void flush_nothing(png_structp) {}
+
+// PNG stores 16-bit samples big-endian; cv::Mat holds them in the host's order.
+constexpr bool kSwap16 = std::endian::native == std::endian::little;
+
+// Runs `steps` (libpng calls) with libpng's error jump armed: false when libpng gave up. The
+// jump lands here, so the caller's variables are untouched by it, and `steps` creates nothing
+// that needs destroying.
+template <typename Steps>
+bool run_libpng(png_structp png, Steps&& steps) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  steps();
+  return true;
+}
+
+}  // namespace
+
+// libpng with the transforms that give what cv::imdecode(IMREAD_UNCHANGED) gives: palette and
+// low-bit grey expanded, transparency as alpha, grey+alpha as BGRA, 16 bits kept, BGR order.
+cv::Mat decode_png(std::span<const std::byte> bytes, const std::filesystem::path& path) {
+  std::string error;
+  MemoryReader reader{bytes, 0};
+  cv::Mat image;
+  std::vector<png_bytep> rows;
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &error, record_error, ignore_warning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    throw FlowFileError(Kind::malformed, path, "cannot decode PNG: out of memory");
+  }
+  const bool decoded = run_libpng(png, [&] {
+    png_set_read_fn(png, &reader, read_from_memory);
+    png_read_info(png, info);
+    const int color = png_get_color_type(png, info);
+    const int depth = png_get_bit_depth(png, info);
+    if (color == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
+    if (color == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(png);
+    if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
+    if (color == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(png);
+    if (depth == 16 && kSwap16) png_set_swap(png);
+    png_set_bgr(png);
+    png_read_update_info(png, info);
+    const auto width = static_cast<int>(png_get_image_width(png, info));
+    const auto height = static_cast<int>(png_get_image_height(png, info));
+    const int channels = png_get_channels(png, info);
+    const int out_depth = png_get_bit_depth(png, info) == 16 ? CV_16U : CV_8U;
+    image.create(height, width, CV_MAKETYPE(out_depth, channels));
+    rows.resize(static_cast<std::size_t>(height));
+    for (int y = 0; y < height; ++y) rows[static_cast<std::size_t>(y)] = image.ptr(y);
+    png_read_image(png, rows.data());
+    png_read_end(png, nullptr);
+  });
+  if (!decoded) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    throw FlowFileError(Kind::malformed, path, "cannot decode PNG: " + error);
+  }
+  png_destroy_read_struct(&png, &info, nullptr);
   return image;
 }
 
 void write_png_atomically(const cv::Mat& image, const std::filesystem::path& path) {
-  std::vector<uchar> encoded;
-  try {
-    if (!cv::imencode(".png", image, encoded)) {
-      throw FlowFileError(Kind::write_failed, path, "PNG encoding failed");
-    }
-  } catch (const cv::Exception& e) {
-    throw FlowFileError(Kind::write_failed, path, std::string("PNG encoding failed: ") + e.what());
+  const int depth = image.depth() == CV_16U ? 16 : 8;
+  const int channels = image.channels();
+  if ((image.depth() != CV_8U && image.depth() != CV_16U) || (channels != 1 && channels != 3 && channels != 4)) {
+    throw FlowFileError(Kind::write_failed, path, "PNG encoding failed: unsupported image type");
   }
+  std::string error;
+  std::vector<unsigned char> encoded;
+  std::vector<png_bytep> rows(static_cast<std::size_t>(image.rows));
+  for (int y = 0; y < image.rows; ++y) rows[static_cast<std::size_t>(y)] = const_cast<png_bytep>(image.ptr(y));
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, record_error, ignore_warning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_write_struct(&png, &info);
+    throw FlowFileError(Kind::write_failed, path, "PNG encoding failed: out of memory");
+  }
+  const bool written = run_libpng(png, [&] {
+    png_set_write_fn(png, &encoded, write_to_memory, flush_nothing);
+    // zlib level 1, as OpenCV's imwrite: flows are written as fast as they arrive.
+    png_set_compression_level(png, 1);
+    const int color =
+        channels == 1 ? PNG_COLOR_TYPE_GRAY : channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA;
+    png_set_IHDR(png, info, static_cast<png_uint_32>(image.cols), static_cast<png_uint_32>(image.rows), depth,
+                 color, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    if (channels > 1) png_set_bgr(png);
+    if (depth == 16 && kSwap16) png_set_swap(png);
+    png_write_image(png, rows.data());
+    png_write_end(png, nullptr);
+  });
+  if (!written) {
+    png_destroy_write_struct(&png, &info);
+    throw FlowFileError(Kind::write_failed, path, "PNG encoding failed: " + error);
+  }
+  png_destroy_write_struct(&png, &info);
   write_file_atomically(path, std::as_bytes(std::span(encoded)));
 }
 

@@ -1,6 +1,7 @@
 #pragma once
-// PNG through OpenCV's imgcodecs, with the header checks and error reporting the flow
-// formats need (internal).
+// PNG through libpng (not OpenCV's imgcodecs, which drags GDAL along and cannot be installed
+// for another architecture beside the host's), with the header checks and error reporting the
+// flow formats need (internal). Images are cv::Mat in OpenCV's channel order (BGR).
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -23,14 +24,14 @@ struct PngHeader {
 PngHeader parse_png_header(std::span<const std::byte> bytes, const std::filesystem::path& path);
 const char* png_color_type_name(int color_type);
 
-// Decodes with IMREAD_UNCHANGED (channels in OpenCV's BGR order). Throws FlowFileError.
+// Decodes as cv::imdecode(IMREAD_UNCHANGED) would: 8 or 16 bits as stored, BGR(A) order,
+// palette and low-bit grey expanded. Throws FlowFileError.
 cv::Mat decode_png(std::span<const std::byte> bytes, const std::filesystem::path& path);
 
 // Encodes an 8- or 16-bit, 1/3/4-channel Mat (BGR order) and writes it atomically.
 void write_png_atomically(const cv::Mat& image, const std::filesystem::path& path);
 
-// Files above this are refused before they are read. Real flow PNGs are a few MB; the cap
-// also keeps the size within the int that cv::imdecode's buffer Mat takes.
+// Files above this are refused before they are read. Real flow PNGs are a few MB.
 inline constexpr std::uint64_t kMaxPngFileBytes = std::uint64_t{1} << 30;
 
 }  // namespace neuflow::flow::detail

@@ -6,12 +6,14 @@ GST_DEBUG_CATEGORY_STATIC(gst_neuflow_flow_sink_debug);
 enum {
   PROP_0,
   PROP_FLOWS_WRITTEN,
+  PROP_BYTES_WRITTEN,
   PROP_BUFFERS_SKIPPED,
 };
 
 struct GstNeuflowFlowSinkPrivate {
   // Under the object lock: the application may read them from any thread.
   guint64 flows_written;
+  guint64 bytes_written;
   guint64 buffers_skipped;
 };
 
@@ -36,6 +38,9 @@ static void gst_neuflow_flow_sink_get_property(GObject *object, guint prop_id, G
     case PROP_FLOWS_WRITTEN:
       g_value_set_uint64(value, priv->flows_written);
       break;
+    case PROP_BYTES_WRITTEN:
+      g_value_set_uint64(value, priv->bytes_written);
+      break;
     case PROP_BUFFERS_SKIPPED:
       g_value_set_uint64(value, priv->buffers_skipped);
       break;
@@ -56,6 +61,7 @@ static GstStateChangeReturn gst_neuflow_flow_sink_change_state(GstElement *eleme
     GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
     GST_OBJECT_LOCK(self);
     priv->flows_written = 0;
+    priv->bytes_written = 0;
     priv->buffers_skipped = 0;
     GST_OBJECT_UNLOCK(self);
     if (!klass->start_writing(self)) {
@@ -105,10 +111,12 @@ static GstFlowReturn gst_neuflow_flow_sink_render(GstBaseSink *sink, GstBuffer *
     return GST_FLOW_ERROR;
   }
 
-  const GstFlowReturn ret = GST_NEUFLOW_FLOW_SINK_GET_CLASS(self)->write_flow(self, buffer, meta);
+  guint64 bytes = 0;
+  const GstFlowReturn ret = GST_NEUFLOW_FLOW_SINK_GET_CLASS(self)->write_flow(self, buffer, meta, &bytes);
   if (ret == GST_FLOW_OK) {
     GST_OBJECT_LOCK(self);
     ++priv->flows_written;
+    priv->bytes_written += bytes;
     GST_OBJECT_UNLOCK(self);
   }
   return ret;
@@ -128,6 +136,12 @@ static void gst_neuflow_flow_sink_class_init(GstNeuflowFlowSinkClass *klass) {
                           "Flows written out (files, or flows published into the ring) since the element started", 0,
                           G_MAXUINT64, 0, ro));
   g_object_class_install_property(
+      gobject_class, PROP_BYTES_WRITTEN,
+      g_param_spec_uint64("bytes-written", "Bytes written",
+                          "Bytes of flow written out (the flow files' sizes, or the vectors published into the "
+                          "ring) since the element started",
+                          0, G_MAXUINT64, 0, ro));
+  g_object_class_install_property(
       gobject_class, PROP_BUFFERS_SKIPPED,
       g_param_spec_uint64("buffers-skipped", "Buffers skipped",
                           "Buffers without flow (no NeuflowFlowMeta) since the element started", 0, G_MAXUINT64, 0,
@@ -144,6 +158,7 @@ static void gst_neuflow_flow_sink_class_init(GstNeuflowFlowSinkClass *klass) {
 static void gst_neuflow_flow_sink_init(GstNeuflowFlowSink *self) {
   GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
   priv->flows_written = 0;
+  priv->bytes_written = 0;
   priv->buffers_skipped = 0;
   // A writer of files and memory, like filesink: each flow goes out as soon as it exists.
   gst_base_sink_set_sync(GST_BASE_SINK(self), FALSE);

@@ -4,7 +4,7 @@
 // share: the caps (any raw video: only the NeuflowFlowMeta is read), no clock sync by
 // default, skipping and counting buffers without flow, checking that a meta holds as many
 // vectors as its grid says, and the flows-written / buffers-skipped counters, reset at start
-// and logged at stop. A subclass implements the three virtual methods below.
+// and logged at stop, and bytes-written. A subclass implements the three virtual methods below.
 #include <gst/base/gstbasesink.h>
 #include <gst/gst.h>
 
@@ -22,9 +22,11 @@ struct _GstNeuflowFlowSinkClass {
   // READY, after the counters are reset; posts an element error and returns FALSE when it
   // cannot (the only error the application then sees).
   gboolean (*start_writing)(GstNeuflowFlowSink *sink);
-  // Writes one flow whose meta holds width × height × 2 floats; on failure posts an element
-  // error and returns GST_FLOW_ERROR. Counted as written when it returns GST_FLOW_OK.
-  GstFlowReturn (*write_flow)(GstNeuflowFlowSink *sink, GstBuffer *buffer, const NeuflowFlowMeta *meta);
+  // Writes one flow whose meta holds width × height × 2 floats and sets `bytes` to what that
+  // put out (the file's size, the vectors published); on failure posts an element error and
+  // returns GST_FLOW_ERROR. Counted as written when it returns GST_FLOW_OK.
+  GstFlowReturn (*write_flow)(GstNeuflowFlowSink *sink, GstBuffer *buffer, const NeuflowFlowMeta *meta,
+                              guint64 *bytes);
   // Releases what start_writing opened; may be called without a start_writing before it.
   void (*stop_writing)(GstNeuflowFlowSink *sink);
   // What the subclass writes, for the log: "flow files", "flows into the ring".

@@ -182,7 +182,7 @@ static void gst_neuflow_shm_sink_stop_writing(GstNeuflowFlowSink *sink) {
 }
 
 static GstFlowReturn gst_neuflow_shm_sink_write_flow(GstNeuflowFlowSink *sink, GstBuffer * /*buffer*/,
-                                                    const NeuflowFlowMeta *meta) {
+                                                    const NeuflowFlowMeta *meta, guint64 *bytes) {
   GstNeuflowShmSink *self = GST_NEUFLOW_SHM_SINK(sink);
   const std::size_t values = static_cast<std::size_t>(meta->width) * meta->height * 2;
 
@@ -211,6 +211,7 @@ static GstFlowReturn gst_neuflow_shm_sink_write_flow(GstNeuflowFlowSink *sink, G
     GST_INFO_OBJECT(self, "flow ring %s is now %ux%u, generation %" G_GUINT64_FORMAT, self->writer->name().c_str(),
                     meta->width, meta->height, self->writer->generation());
   }
+  *bytes = values * sizeof(float);
   return GST_FLOW_OK;
 }
 

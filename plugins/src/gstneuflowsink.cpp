@@ -455,7 +455,7 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
 }
 
 static GstFlowReturn gst_neuflow_sink_write_flow(GstNeuflowFlowSink *sink, GstBuffer * /*buffer*/,
-                                                 const NeuflowFlowMeta *meta) {
+                                                 const NeuflowFlowMeta *meta, guint64 *bytes) {
   GstNeuflowSink *self = GST_NEUFLOW_SINK(sink);
 
   GST_OBJECT_LOCK(self);
@@ -479,6 +479,10 @@ static GstFlowReturn gst_neuflow_sink_write_flow(GstNeuflowFlowSink *sink, GstBu
   }
   GST_LOG_OBJECT(self, "wrote %s: %ux%u, frames %" G_GUINT64_FORMAT " -> %" G_GUINT64_FORMAT, path.c_str(),
                  meta->width, meta->height, meta->from_frame, meta->to_frame);
+  // Measured before retention may delete the file again.
+  std::error_code size_error;
+  const auto size = std::filesystem::file_size(path, size_error);
+  *bytes = size_error ? 0 : static_cast<guint64>(size);
 
   if (!gst_neuflow_sink_append_index(self, index, meta, path)) return GST_FLOW_ERROR;
   gst_neuflow_sink_apply_retention(self, path);

@@ -29,7 +29,7 @@ std::vector<StreamMetrics> known_snapshot() {
   front.restarts = 1;
   for (const double seconds : {0.125, 0.25, 0.5}) front.inference.add(seconds);  // 0.25 is on a bound: le="0.25"
   front.uptime_s = 81.5;
-  front.sinks = {{"archive", "files", true, 1149, 0}, {"live", "rtsp", false, 0, 1}};
+  front.sinks = {{"archive", "files", true, 1149, 4711, 0}, {"live", "rtsp", false, 0, 0, 1}};
 
   StreamMetrics odd;
   odd.stream = "odd \"name\"\\ with\nnewline";
@@ -120,6 +120,9 @@ neuflow_stream_uptime_seconds{stream="odd \"name\"\\ with\nnewline"} 0
 # HELP neuflow_sink_flows_written_total Flows the sink wrote (flow files, or flows published into the ring).
 # TYPE neuflow_sink_flows_written_total counter
 neuflow_sink_flows_written_total{stream="front",sink="archive",kind="files"} 1149
+# HELP neuflow_sink_bytes_written_total Bytes the sink wrote: the flow files' sizes, or the vectors published into the ring.
+# TYPE neuflow_sink_bytes_written_total counter
+neuflow_sink_bytes_written_total{stream="front",sink="archive",kind="files"} 4711
 # HELP neuflow_sink_failures_total Times the sink failed or could not be built and was cut off.
 # TYPE neuflow_sink_failures_total counter
 neuflow_sink_failures_total{stream="front",sink="archive",kind="files"} 0
@@ -279,13 +282,13 @@ TEST(PrometheusText, OutputFollowsTheTextFormatGrammar) {
   third.inference.add(std::numeric_limits<double>::infinity());  // not counted
   third.inference.add(1e9);                                     // counted under +Inf
   third.frames_in = std::numeric_limits<std::uint64_t>::max();
-  third.sinks = {{"odd \"sink\"", "shm", true, 7, 2}};
+  third.sinks = {{"odd \"sink\"", "shm", true, 7, 672, 2}};
   snapshot.push_back(third);
 
   const Parsed p = parse_exposition(render_prometheus(snapshot, 3600.0, "0.1.0-dev \"x\""));
   for (const auto& e : p.errors) ADD_FAILURE() << e;
 
-  EXPECT_EQ(p.types.size(), 13u);
+  EXPECT_EQ(p.types.size(), 14u);
   EXPECT_EQ(p.types.at("neuflow_inference_seconds"), "histogram");
   std::set<std::string> streams;
   for (const auto& labels : p.labels) {

@@ -143,6 +143,7 @@ TEST(NeuflowShmSink, ReaderReadsEveryFlowWithExactValuesAndMetadata) {
   std::vector<float> small(10);
   EXPECT_THROW(reader.read(1, small, info), std::invalid_argument);
   EXPECT_EQ(uint64_property(s.element.get(), "flows-written"), 3u);
+  EXPECT_EQ(uint64_property(s.element.get(), "bytes-written"), 3u * 8u * 6u * 2u * sizeof(float));
   EXPECT_FALSE(pop_error(s.bus.get()).found);
 }
 

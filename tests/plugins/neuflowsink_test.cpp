@@ -132,6 +132,9 @@ TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
                                       "7,3,4,,133333333,flow_007.flo"}));
 
   EXPECT_EQ(uint64_property(s.element.get(), "flows-written"), 3u);
+  EXPECT_EQ(uint64_property(s.element.get(), "bytes-written"),
+            fs::file_size(dir.path() / "flow_005.flo") + fs::file_size(dir.path() / "flow_006.flo") +
+                fs::file_size(dir.path() / "flow_007.flo"));
   EXPECT_EQ(uint64_property(s.element.get(), "buffers-skipped"), 1u);
   gint index = 0;
   g_object_get(s.element.get(), "index", &index, nullptr);
