@@ -460,7 +460,10 @@ class DaemonFailures(DaemonTestCase):
             time.sleep(0.2)
         # The folder disappears under the sink and a file takes its place: every write fails,
         # even for root.
-        shutil.rmtree(doomed)
+        # The sink may create a temporary file in it while rmtree runs: remove until it is gone.
+        deadline = time.monotonic() + 10
+        while os.path.isdir(doomed) and time.monotonic() < deadline:
+            shutil.rmtree(doomed, ignore_errors=True)
         with open(doomed, "w") as f:
             f.write("not a folder\n")
         d.wait_log(r"stream s: sink doomed failed: .*other sinks", timeout=30)

@@ -18,6 +18,7 @@ namespace {
 using model::Checkpoint;
 using model::CheckpointError;
 using model::load_checkpoint;
+using model::read_checkpoint_header;
 
 // --- the fixture (a checkpoint in exactly the published format) -------------------------
 
@@ -55,6 +56,21 @@ TEST(CheckpointFixture, KeysAreInTheArchitectureTablesOrder) {
     EXPECT_EQ(ckpt.keys[i], table[i].name) << "at " << i;
     EXPECT_EQ(ckpt.at(table[i].name).shape, table[i].shape) << table[i].name;
   }
+}
+
+// The header alone: the same keys, shapes and dtypes as a full load, no data read.
+TEST(CheckpointFixture, HeaderHasEveryTensorsShapeButNoData) {
+  NEUFLOW_REQUIRE_FIXTURE(path, "neuflow-v2-seed0/checkpoint.pth");
+  const Checkpoint full = load_checkpoint(path);
+  const Checkpoint header = read_checkpoint_header(path);
+  EXPECT_EQ(header.keys, full.keys);
+  for (const auto& key : full.keys) {
+    EXPECT_EQ(header.at(key).shape, full.at(key).shape) << key;
+    EXPECT_EQ(header.at(key).dtype, full.at(key).dtype) << key;
+    EXPECT_TRUE(header.at(key).data.empty()) << key;
+  }
+  EXPECT_EQ(model::find_architecture_mismatch(header), std::nullopt);
+  EXPECT_THROW(read_checkpoint_header(path.parent_path() / "frame0.png"), CheckpointError);
 }
 
 TEST(CheckpointFixture, ValuesMatchTheRawStorages) {

@@ -388,9 +388,12 @@ const CheckpointTensor& Checkpoint::at(const std::string& key) const {
   throw CheckpointError(Kind::kFormat, "checkpoint '" + path + "' has no tensor '" + key + "'");
 }
 
-Checkpoint load_checkpoint(const std::filesystem::path& path) {
+namespace {
+
+// The loader's errors, each naming the file.
+Checkpoint load_naming_the_file(const std::filesystem::path& path, bool with_data) {
   try {
-    return Loader(path, true).load();
+    return Loader(path, with_data).load();
   } catch (const CheckpointError& e) {
     throw CheckpointError(e.kind(), "checkpoint '" + path.string() + "': " + e.what());
   } catch (const std::bad_alloc&) {
@@ -398,14 +401,10 @@ Checkpoint load_checkpoint(const std::filesystem::path& path) {
   }
 }
 
-Checkpoint read_checkpoint_header(const std::filesystem::path& path) {
-  try {
-    return Loader(path, false).load();
-  } catch (const CheckpointError& e) {
-    throw CheckpointError(e.kind(), "checkpoint '" + path.string() + "': " + e.what());
-  } catch (const std::bad_alloc&) {
-    throw CheckpointError(Kind::kFormat, "checkpoint '" + path.string() + "': out of memory");
-  }
-}
+}  // namespace
+
+Checkpoint load_checkpoint(const std::filesystem::path& path) { return load_naming_the_file(path, true); }
+
+Checkpoint read_checkpoint_header(const std::filesystem::path& path) { return load_naming_the_file(path, false); }
 
 }  // namespace neuflow::model
