@@ -84,21 +84,16 @@ Stream::Stream(StreamConfig config, int threads, DaemonSettings settings, Stream
       base_{carried.frames_in, carried.frames_processed, carried.frames_dropped, carried.flows},
       sink_base_(std::move(carried.sinks)),
       inference_(carried.inference),
-      restarts_(carried.restarts),
-      sink_failures_(carried.sink_failures) {}
+      restarts_(carried.restarts) {}
 
 StreamTotals Stream::totals() const {
   const StreamSnapshot s = snapshot();
-  StreamTotals t{s.frames_in, s.frames_processed, s.frames_dropped, s.flows, s.restarts, s.sink_failures,
-                 s.inference, {}};
+  StreamTotals t{s.frames_in, s.frames_processed, s.frames_dropped, s.flows, s.restarts, s.inference, {}};
   for (const auto& sink : s.sinks) t.sinks[sink.name] = {sink.flows_written, sink.bytes_written, sink.failures};
   return t;
 }
 
-void Stream::count_sink_failure(const std::string& sink) {
-  ++sink_failures_;
-  ++sink_base_[sink].failures;
-}
+void Stream::count_sink_failure(const std::string& sink) { ++sink_base_[sink].failures; }
 
 // Each flow's inference time, from the meta the neuflow element attaches. The meta's API type
 // is looked up by name: the daemon reads the struct (neuflow/gst/flow_meta.h) without linking
@@ -371,7 +366,6 @@ void Stream::read_counters() {
                                          uint64_property(branch->writer, "bytes-written"), 0};
     }
   }
-  g_object_get(flow, "mean-latency", &latency_ms_, nullptr);
 }
 
 void Stream::tick() {
@@ -406,6 +400,10 @@ bool Stream::healthy() const {
   return !(state_ == StreamState::stopping && seconds_since(state_since_) > settings_.stop_timeout + 10);
 }
 
+double Stream::seconds_until_restart() const {
+  return std::max(0.0, std::chrono::duration<double>(restart_at_ - Clock::now()).count());
+}
+
 StreamSnapshot Stream::snapshot() const {
   StreamSnapshot s;
   s.name = config_.name;
@@ -414,10 +412,7 @@ StreamSnapshot Stream::snapshot() const {
   s.frames_processed = base_.processed + current_.processed;
   s.frames_dropped = base_.dropped + current_.dropped;
   s.flows = base_.flows + current_.flows;
-  s.latency_ms = latency_ms_;
-  s.rate_fps = rate_fps_;
   s.restarts = restarts_;
-  s.sink_failures = sink_failures_;
   s.inference = inference_.counts();
   for (const SinkConfig& sink : config_.sinks) {
     StreamSnapshot::Sink out;
@@ -438,7 +433,7 @@ StreamSnapshot Stream::snapshot() const {
   }
   s.seconds_in_state = seconds_since(state_since_);
   if (state_ == StreamState::backoff) {
-    s.retry_in_s = std::max(0.0, std::chrono::duration<double>(restart_at_ - Clock::now()).count());
+    s.retry_in_s = seconds_until_restart();
   }
   return s;
 }
@@ -455,7 +450,7 @@ std::string Stream::status() const {
       }
       break;
     case StreamState::backoff:
-      std::snprintf(buf, sizeof buf, "%s retry in %.0f s", config_.name.c_str(), snapshot().retry_in_s);
+      std::snprintf(buf, sizeof buf, "%s retry in %.0f s", config_.name.c_str(), seconds_until_restart());
       break;
     default:
       std::snprintf(buf, sizeof buf, "%s %s", config_.name.c_str(), to_string(state_));

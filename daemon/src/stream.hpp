@@ -34,10 +34,7 @@ struct StreamSnapshot {
   std::uint64_t frames_processed = 0;
   std::uint64_t frames_dropped = 0;
   std::uint64_t flows = 0;             // frames that left with a flow
-  double latency_ms = 0;               // mean inference time of the current run
-  double rate_fps = 0;                 // frames leaving the flow element per second, recently
   std::uint64_t restarts = 0;
-  std::uint64_t sink_failures = 0;     // all sinks together
   LatencyCounts inference;             // every flow's inference time, over all runs
   double seconds_in_state = 0;
   double retry_in_s = 0;               // backoff only
@@ -67,7 +64,6 @@ struct StreamTotals {
   std::uint64_t frames_dropped = 0;
   std::uint64_t flows = 0;
   std::uint64_t restarts = 0;
-  std::uint64_t sink_failures = 0;
   LatencyCounts inference;
   std::map<std::string, SinkTotals> sinks;  // by sink name
 };
@@ -111,6 +107,7 @@ class Stream {
   static gboolean on_stop_timeout(gpointer self);
   static GstPadProbeReturn on_flow_buffer(GstPad*, GstPadProbeInfo* info, gpointer self);
   void count_sink_failure(const std::string& sink);
+  double seconds_until_restart() const;  // backoff
 
   void handle_message(GstMessage* message);
   void fail(const std::string& reason);
@@ -141,7 +138,6 @@ class Stream {
   struct Counters {
     std::uint64_t in = 0, processed = 0, dropped = 0, flows = 0;
   } base_, current_;
-  double latency_ms_ = 0;
   double rate_fps_ = 0;
   std::uint64_t last_processed_ = 0;  // for stall detection
   std::uint64_t rate_base_ = 0;       // processed count at the last rate measurement
@@ -154,7 +150,6 @@ class Stream {
   LatencyHistogram inference_;
   gulong inference_probe_ = 0;
   std::uint64_t restarts_ = 0;
-  std::uint64_t sink_failures_ = 0;
 };
 
 }  // namespace neuflow::daemon
