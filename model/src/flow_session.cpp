@@ -5,19 +5,22 @@
 #include <stdexcept>
 #include <utility>
 
-#include "dnnl/context.hpp"
 #include "frame_geometry.hpp"
-#include "network.hpp"
+#include "inference_backend.hpp"
+#include "vulkan/vulkan_backend.hpp"
 
 namespace neuflow::model {
 
+// Slots of the backend: the stream alternates between two (the previous frame's and the
+// current one's); compute() uses the two that do not hold the stream's previous frame.
 struct FlowSession::State {
-  dnnl::stream stream{cpu_engine()};
   FrameGeometry geometry;
-  std::unique_ptr<NetworkPlan> plan;
+  std::unique_ptr<InferenceBackend> backend;
+  std::shared_ptr<VulkanContext> vulkan;  // set while the session runs on a Vulkan device
+  std::string description = "cpu";
+  std::string fallback;
   Tensor input, model_flow;
-  FrameFeatures previous, current;   // the stream
-  FrameFeatures pair_first, pair_second;  // compute(), kept apart from the stream
+  int previous_slot = 0;
   bool has_previous = false;
   StageObserver observer;
 };
@@ -29,12 +32,31 @@ void validate(const Iterations& it) {
   if (auto problem = check_iterations_s8(it.s8)) throw std::invalid_argument("iters-s8: " + *problem);
 }
 
+// The two slots other than `taken`.
+std::pair<int, int> free_slots(int taken) {
+  const int a = (taken + 1) % InferenceBackend::kSlots, b = (taken + 2) % InferenceBackend::kSlots;
+  return {a, b};
+}
+
 }  // namespace
 
 FlowSession::FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions options)
     : options_(options), model_(std::move(model)), state_(std::make_unique<State>()) {
   if (!model_) throw std::invalid_argument("FlowSession needs a loaded model");
   if (auto problem = check_session_options(options_)) throw std::invalid_argument(*problem);
+  auto& s = *state_;
+  if (options_.backend == Backend::vulkan) {
+    s.vulkan = open_vulkan(model_, options_.device);
+  } else if (options_.backend == Backend::automatic) {
+    if (const int gpu = find_gpu_for_auto(options_.device); gpu >= 0) {
+      try {
+        s.vulkan = open_vulkan(model_, gpu);
+      } catch (const BackendError& e) {
+        s.fallback = std::string("backend auto: ") + e.what() + "; running on the CPU instead";
+      }
+    }
+  }
+  if (s.vulkan) s.description = describe(*s.vulkan);
 }
 
 FlowSession::~FlowSession() = default;
@@ -42,6 +64,9 @@ FlowSession::~FlowSession() = default;
 void FlowSession::set_observer(StageObserver observer) { state_->observer = std::move(observer); }
 
 void FlowSession::reset() { state_->has_previous = false; }
+
+const std::string& FlowSession::backend_description() const { return state_->description; }
+const std::string& FlowSession::fallback_warning() const { return state_->fallback; }
 
 namespace {
 
@@ -51,14 +76,26 @@ void apply_threads(int threads) {
 }
 
 // Makes the state ready for frames of this size: a new size ends the stream, and a new
-// model size replaces the plan (the old one's buffers are released first).
-const FrameGeometry& prepare_plan(FlowSession::State& s, const NetworkWeights& weights, const SessionOptions& options,
+// model size replaces the plan (the old one's buffers are released first). With
+// backend=auto, a GPU that cannot hold this size leaves the session on the CPU.
+const FrameGeometry& prepare_plan(FlowSession::State& s, const FlowModel& model, const SessionOptions& options,
                                   int width, int height) {
   const FrameGeometry g = plan_geometry(width, height, options);
-  if (s.plan && g == s.geometry) return s.geometry;
-  if (!s.plan || s.plan->width() != g.model_width || s.plan->height() != g.model_height) {
-    s.plan.reset();
-    s.plan = std::make_unique<NetworkPlan>(weights, g.model_height, g.model_width);
+  if (s.backend && g == s.geometry) return s.geometry;
+  if (!s.backend || s.backend->width() != g.model_width || s.backend->height() != g.model_height) {
+    s.backend.reset();
+    s.has_previous = false;
+    if (s.vulkan) {
+      try {
+        s.backend = make_vulkan_backend(s.vulkan, g.model_height, g.model_width);
+      } catch (const BackendError& e) {
+        if (options.backend != Backend::automatic) throw;
+        s.fallback = std::string("backend auto: ") + e.what() + "; running on the CPU instead";
+        s.vulkan.reset();
+        s.description = "cpu";
+      }
+    }
+    if (!s.backend) s.backend = make_cpu_backend(model, g.model_height, g.model_width);
   }
   s.geometry = g;
   s.has_previous = false;
@@ -78,12 +115,13 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   }
   apply_threads(options_.threads);
   auto& s = *state_;
-  const FrameGeometry& g = prepare_plan(s, model_->weights(), options_, frame0.width, frame0.height);
+  const FrameGeometry& g = prepare_plan(s, *model_, options_, frame0.width, frame0.height);
+  const auto [first, second] = free_slots(s.previous_slot);
   prepare_input(frame0, g, options_.network_order, s.input);
-  s.plan->encode(s.stream, s.input, s.pair_first);
+  s.backend->encode(s.input, first);
   prepare_input(frame1, g, options_.network_order, s.input);
-  s.plan->encode(s.stream, s.input, s.pair_second);
-  s.plan->flow(s.stream, s.pair_first, s.pair_second, iterations.s16, iterations.s8, s.model_flow, &s.observer);
+  s.backend->encode(s.input, second);
+  s.backend->flow(first, second, iterations, s.model_flow, &s.observer);
   return restore_flow(s.model_flow, g);
 }
 
@@ -93,15 +131,16 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   validate(iterations);
   apply_threads(options_.threads);
   auto& s = *state_;
-  const FrameGeometry& g = prepare_plan(s, model_->weights(), options_, frame.width, frame.height);
+  const FrameGeometry& g = prepare_plan(s, *model_, options_, frame.width, frame.height);
+  const int current = free_slots(s.previous_slot).first;
   prepare_input(frame, g, options_.network_order, s.input);
-  s.plan->encode(s.stream, s.input, s.current);
+  s.backend->encode(s.input, current);
   std::optional<flow::FlowField> result;
   if (s.has_previous) {
-    s.plan->flow(s.stream, s.previous, s.current, iterations.s16, iterations.s8, s.model_flow, &s.observer);
+    s.backend->flow(s.previous_slot, current, iterations, s.model_flow, &s.observer);
     result = restore_flow(s.model_flow, g);
   }
-  std::swap(s.previous, s.current);
+  s.previous_slot = current;
   s.has_previous = true;
   return result;
 }

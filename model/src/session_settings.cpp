@@ -25,6 +25,12 @@ std::optional<std::string> check_threads(int value) {
   return check_range(value, SessionLimits::max_threads, "a thread count (0: all cores)");
 }
 
+std::optional<std::string> check_device(int value) {
+  if (value >= -1 && value <= SessionLimits::max_device) return std::nullopt;
+  return "expected a Vulkan device index 0 to " + std::to_string(SessionLimits::max_device) +
+         " (or -1 for the first GPU), got " + std::to_string(value);
+}
+
 std::optional<std::string> check_model_side(int value) {
   using L = SessionLimits;
   if (value == 0 ||
@@ -50,6 +56,7 @@ std::optional<std::string> check_session_options(const SessionOptions& options) 
   if (auto problem = check_iterations_s8(options.iterations.s8)) return "iters-s8: " + *problem;
   if (auto problem = check_model_size(options.model_width, options.model_height)) return problem;
   if (auto problem = check_threads(options.threads)) return "threads: " + *problem;
+  if (auto problem = check_device(options.device)) return "device: " + *problem;
   return std::nullopt;
 }
 
@@ -62,6 +69,17 @@ ModelSize model_size_for(int frame_width, int frame_height, const SessionOptions
 std::optional<ChannelOrder> parse_channel_order(std::string_view name) {
   if (name == "rgb") return ChannelOrder::rgb;
   if (name == "bgr") return ChannelOrder::bgr;
+  return std::nullopt;
+}
+
+}  // namespace neuflow::model
+
+namespace neuflow::model {
+
+std::optional<Backend> parse_backend(std::string_view name) {
+  if (name == "auto") return Backend::automatic;
+  if (name == "cpu") return Backend::cpu;
+  if (name == "vulkan") return Backend::vulkan;
   return std::nullopt;
 }
 

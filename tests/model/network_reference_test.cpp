@@ -14,6 +14,7 @@
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/flow/npy_format.hpp"
 #include "support/fixtures.hpp"
+#include "support/vulkan.hpp"
 
 namespace neuflow::model {
 namespace {
@@ -42,13 +43,19 @@ ImageView view_of(const cv::Mat& bgr) {
   return ImageView{bgr.data, bgr.cols, bgr.rows, static_cast<std::ptrdiff_t>(bgr.step[0]), ChannelOrder::bgr};
 }
 
-TEST(NetworkReference, EveryStageMatchesTheReference) {
+// Both backends against the same reference at the same tolerances.
+class NetworkReference : public ::testing::TestWithParam<Backend> {};
+
+TEST_P(NetworkReference, EveryStageMatchesTheReference) {
   NEUFLOW_REQUIRE_FIXTURE(dir, "neuflow-v2-seed0");
+  if (GetParam() == Backend::vulkan) {
+    NEUFLOW_REQUIRE_VULKAN();
+  }
   const auto absmax = read_absmax(dir / "manifest.json");
   ASSERT_EQ(absmax.size(), 28u) << "manifest.json not understood";
 
   const auto model = FlowModel::load(dir / "checkpoint.pth");
-  FlowSession session(model, {.iterations = {1, 8}, .threads = 2});
+  FlowSession session(model, {.iterations = {1, 8}, .threads = 2, .backend = GetParam()});
   std::map<std::string, Captured> seen;
   session.set_observer([&](const StageTensor& t) {
     seen[key(t.name, t.frame)] = {t.height, t.width, t.channels,
@@ -111,7 +118,15 @@ TEST(NetworkReference, EveryStageMatchesTheReference) {
     max_err = std::max(max_err, static_cast<double>(std::fabs(result.uv[2 * p + 1] - ref.data[320 * 256 + p])));
   }
   EXPECT_LT(max_err, 1e-2);
+  if (GetParam() == Backend::vulkan) {
+    NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES();
+  }
 }
+
+INSTANTIATE_TEST_SUITE_P(Backends, NetworkReference, ::testing::Values(Backend::cpu, Backend::vulkan),
+                         [](const ::testing::TestParamInfo<Backend>& param) {
+                           return std::string(backend_name(param.param));
+                         });
 
 }  // namespace
 }  // namespace neuflow::model

@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/gpu_devices.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
 
@@ -26,6 +28,9 @@ struct ImageView {
 
 class FlowSession {
  public:
+  // Opens the backend the options ask for. Throws std::invalid_argument for unusable options
+  // and BackendError (gpu_devices.hpp) when backend=vulkan cannot open its device; with
+  // backend=auto a GPU that fails is left for the CPU (see fallback_warning()).
   explicit FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions options = {});
   ~FlowSession();
   FlowSession(const FlowSession&) = delete;
@@ -47,6 +52,12 @@ class FlowSession {
   void set_observer(StageObserver observer);
 
   const SessionOptions& options() const { return options_; }
+
+  // Where the network runs: "cpu" or "vulkan device 0 (NVIDIA H200)".
+  const std::string& backend_description() const;
+  // With backend=auto, why a GPU that was found is not used (the session then runs on the
+  // CPU); empty otherwise. Callers report it once.
+  const std::string& fallback_warning() const;
 
   struct State;  // opaque per-session buffers and stream state
 

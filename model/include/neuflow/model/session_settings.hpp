@@ -11,6 +11,11 @@ namespace neuflow::model {
 
 enum class ChannelOrder { rgb, bgr };
 
+// Where the network runs: `automatic` ("auto") takes the first discrete or integrated GPU
+// through Vulkan and the CPU when there is none; `vulkan` insists on a Vulkan device (a
+// software one such as lavapipe included) and fails when there is none.
+enum class Backend { automatic, cpu, vulkan };
+
 struct Iterations {
   int s16 = 1;  // refinement iterations at 1/16
   int s8 = 8;   // refinement iterations at 1/8
@@ -25,6 +30,7 @@ struct SessionLimits {
   static constexpr int min_side = 32;
   static constexpr int max_side = 16384;  // frames and model sizes alike
   static constexpr int max_threads = 1024;
+  static constexpr int max_device = 63;  // a Vulkan device index; -1: the first GPU
 };
 
 struct SessionOptions {
@@ -38,6 +44,10 @@ struct SessionOptions {
   // The order the network is fed, whatever order the images hold: RGB as the published
   // weights were trained, BGR as the reference demo scripts (which read with OpenCV) feed it.
   ChannelOrder network_order = ChannelOrder::rgb;
+  Backend backend = Backend::automatic;
+  // A Vulkan device's index (`neuflow devices` lists them), or -1: the first discrete or
+  // integrated GPU (for `vulkan` without one, the first device).
+  int device = -1;
   bool operator==(const SessionOptions&) const = default;
 };
 
@@ -47,6 +57,7 @@ std::optional<std::string> check_iterations_s16(int value);
 std::optional<std::string> check_iterations_s8(int value);
 std::optional<std::string> check_model_side(int value);   // one of model width/height; 0 allowed
 std::optional<std::string> check_threads(int value);
+std::optional<std::string> check_device(int value);
 // Both sides: each usable, and both 0 or both set.
 std::optional<std::string> check_model_size(int width, int height);
 // The whole set, each problem prefixed with the setting's name ("iters-s8: expected …").
@@ -64,5 +75,10 @@ ModelSize model_size_for(int frame_width, int frame_height, const SessionOptions
 
 constexpr std::string_view channel_order_name(ChannelOrder order) { return order == ChannelOrder::bgr ? "bgr" : "rgb"; }
 std::optional<ChannelOrder> parse_channel_order(std::string_view name);
+
+constexpr std::string_view backend_name(Backend backend) {
+  return backend == Backend::cpu ? "cpu" : backend == Backend::vulkan ? "vulkan" : "auto";
+}
+std::optional<Backend> parse_backend(std::string_view name);  // "auto", "cpu", "vulkan"
 
 }  // namespace neuflow::model

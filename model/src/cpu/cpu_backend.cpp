@@ -1,0 +1,35 @@
+#include <array>
+
+#include "dnnl/context.hpp"
+#include "inference_backend.hpp"
+#include "network.hpp"
+
+namespace neuflow::model {
+
+namespace {
+
+// Today's oneDNN network behind the backend interface; the frames' features stay in host memory.
+class CpuBackend final : public InferenceBackend {
+ public:
+  CpuBackend(const NetworkWeights& weights, int height, int width) : plan_(weights, height, width) {}
+  int width() const override { return plan_.width(); }
+  int height() const override { return plan_.height(); }
+  void encode(const Tensor& image, int slot) override { plan_.encode(stream_, image, slots_[static_cast<std::size_t>(slot)]); }
+  void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer) override {
+    plan_.flow(stream_, slots_[static_cast<std::size_t>(slot0)], slots_[static_cast<std::size_t>(slot1)], iterations.s16,
+               iterations.s8, out, observer);
+  }
+
+ private:
+  dnnl::stream stream_{cpu_engine()};
+  NetworkPlan plan_;
+  std::array<FrameFeatures, kSlots> slots_;
+};
+
+}  // namespace
+
+std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width) {
+  return std::make_unique<CpuBackend>(model.weights(), height, width);
+}
+
+}  // namespace neuflow::model

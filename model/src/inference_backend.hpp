@@ -1,0 +1,35 @@
+#pragma once
+// The narrow interface FlowSession runs the network through, one implementation per backend
+// (cpu/: oneDNN; vulkan/: compute shaders). A backend holds a plan for one model size and
+// keeps the features of up to kSlots encoded frames, so the session can stream (each frame
+// encoded once, serving two pairs) and compute pairs without disturbing the stream.
+#include <memory>
+#include <string>
+
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/session_settings.hpp"
+#include "neuflow/model/stage_observer.hpp"
+#include "tensor.hpp"
+
+namespace neuflow::model {
+
+class InferenceBackend {
+ public:
+  static constexpr int kSlots = 3;
+
+  virtual ~InferenceBackend() = default;
+
+  virtual int width() const = 0;
+  virtual int height() const = 0;
+
+  // image: [height, width, 3] in 0..1, in the network's channel order.
+  virtual void encode(const Tensor& image, int slot) = 0;
+  // Flow from the frame in slot0 to the frame in slot1: [height, width, 2] (u, v). The
+  // observer, when set, sees every named stage (the same names on every backend).
+  virtual void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,
+                    const StageObserver* observer) = 0;
+};
+
+std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width);
+
+}  // namespace neuflow::model

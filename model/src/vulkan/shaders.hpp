@@ -1,0 +1,27 @@
+#pragma once
+// The compute shaders, compiled to SPIR-V at build time (glslc) and embedded in the library.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+namespace neuflow::model::vulkan {
+
+enum class Shader {
+  conv2d,          // matmul.comp with IMPLICIT_CONV
+  matmul,          // matmul.comp, strided operands
+  avgpool2x,
+  resample,
+  axpby,
+  channel_affine,
+  softmax_rows,
+  layer_norm,
+  local_correlation,
+  refine_update,
+  convex_upsample,
+};
+inline constexpr std::size_t kShaderCount = 11;
+
+std::span<const std::uint32_t> spirv(Shader shader);
+const char* shader_name(Shader shader);
+
+}  // namespace neuflow::model::vulkan

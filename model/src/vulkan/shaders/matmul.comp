@@ -1,0 +1,150 @@
+#version 450
+// C = act(alpha · A · B + bias + addend), tiled through workgroup memory: 64×64 outputs per
+// workgroup, 4×4 per invocation, K in steps of 16. Compiled twice:
+//  - IMPLICIT_CONV: A is a convolution's OIHW weights read as a row-major [Cout][Cin·k·k]
+//    matrix and B the im2col of a planar [C][H][W] input, gathered on the fly (never stored);
+//    C is the planar output. Bias and activation fused; `addend` (same shape as C) is added
+//    before the activation.
+//  - otherwise a general strided product (attention, matching): every operand has a row and a
+//    column stride, so transposes are free.
+layout(local_size_x = 16, local_size_y = 16) in;
+
+layout(std430, binding = 0) readonly buffer BufA { float a_data[]; };
+layout(std430, binding = 1) readonly buffer BufB { float b_data[]; };
+layout(std430, binding = 2) buffer BufC { float c_data[]; };
+layout(std430, binding = 3) readonly buffer BufD { float d_data[]; };  // the addend
+
+#ifdef IMPLICIT_CONV
+layout(push_constant) uniform Params {
+  int in_c, in_h, in_w, in_off;   // B: planar input, channel 0 at in_off (binding 1)
+  int out_c, out_h, out_w, out_off;  // C: planar output, channel 0 at out_off
+  int kernel, stride, pad, act;
+  int w_off;    // A: weights at w_off in binding 0
+  int bias_off; // in binding 0 (with the weights), < 0: none
+  int add_off;  // addend in binding 3, < 0: none
+  float alpha;
+} p;
+#else
+layout(push_constant) uniform Params {
+  int m, n, k;
+  int a_off, a_rs, a_cs;
+  int b_off, b_rs, b_cs;
+  int c_off, c_rs, c_cs;
+  int bias_off;  // per row of C, in binding 0 (with A); < 0: none
+  int act;
+  float alpha;
+} p;
+#endif
+
+const int BM = 64, BN = 64, BK = 16;
+shared float tile_a[BK][BM];
+shared float tile_b[BK][BN];
+
+float erf_approx(float x) {
+  // Abramowitz & Stegun 7.1.26 refined (|error| < 1.2e-7): GLSL has no erf.
+  float t = 1.0 / (1.0 + 0.5 * abs(x));
+  float y = 1.0 - t * exp(-x * x - 1.26551223 + t * (1.00002368 + t * (0.37409196 + t * (0.09678418 +
+            t * (-0.18628806 + t * (0.27886807 + t * (-1.13520398 + t * (1.48851587 +
+            t * (-0.82215223 + t * 0.17087277)))))))));
+  return x >= 0.0 ? y : -y;
+}
+
+float activate(float v, int act) {
+  if (act == 1) return v > 0.0 ? v : 0.1 * v;          // LeakyReLU(0.1)
+  if (act == 2) return max(v, 0.0);                     // ReLU
+  if (act == 3) return 0.5 * v * (1.0 + erf_approx(v * 0.70710678118654752)); // exact GELU
+  return v;
+}
+
+void main() {
+  const int tx = int(gl_LocalInvocationID.x), ty = int(gl_LocalInvocationID.y);
+  const int tid = ty * 16 + tx;
+  const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
+  const int col0 = int(gl_WorkGroupID.x) * BN;  // columns of C (output pixels)
+#ifdef IMPLICIT_CONV
+  const int M = p.out_c, N = p.out_h * p.out_w, K = p.in_c * p.kernel * p.kernel;
+  const int kk2 = p.kernel * p.kernel;
+  const int in_plane = p.in_h * p.in_w;
+  // The column this invocation gathers for B: fixed across the K loop (256 % 64 == 0).
+  const int my_col = col0 + (tid % BN);
+  const int oy = my_col / p.out_w, ox = my_col % p.out_w;
+  const int iy0 = oy * p.stride - p.pad, ix0 = ox * p.stride - p.pad;
+  const bool col_ok = my_col < N;
+#else
+  const int M = p.m, N = p.n, K = p.k;
+#endif
+
+  float acc[4][4];
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) acc[i][j] = 0.0;
+
+  for (int k0 = 0; k0 < K; k0 += BK) {
+    // A tile: 64 rows × 16 k, adjacent invocations read adjacent k (row-major weights).
+    for (int r = 0; r < 4; ++r) {
+      const int e = tid + 256 * r;
+      const int kk = e % BK, mm = e / BK;
+      const int gm = row0 + mm, gk = k0 + kk;
+      float v = 0.0;
+      if (gm < M && gk < K) {
+#ifdef IMPLICIT_CONV
+        v = a_data[p.w_off + gm * K + gk];
+#else
+        v = a_data[p.a_off + gm * p.a_rs + gk * p.a_cs];
+#endif
+      }
+      tile_a[kk][mm] = v;
+    }
+    // B tile: 16 k × 64 columns, adjacent invocations read adjacent columns.
+    for (int r = 0; r < 4; ++r) {
+      const int e = tid + 256 * r;
+      const int nn = e % BN, kk = e / BN;
+      const int gk = k0 + kk;
+      float v = 0.0;
+#ifdef IMPLICIT_CONV
+      if (col_ok && gk < K) {
+        const int ci = gk / kk2, rem = gk - ci * kk2;
+        const int ky = rem / p.kernel, kx = rem - ky * p.kernel;
+        const int iy = iy0 + ky, ix = ix0 + kx;
+        if (iy >= 0 && iy < p.in_h && ix >= 0 && ix < p.in_w) {
+          v = b_data[p.in_off + ci * in_plane + iy * p.in_w + ix];
+        }
+      }
+#else
+      const int gn = col0 + nn;
+      if (gn < N && gk < K) v = b_data[p.b_off + gk * p.b_rs + gn * p.b_cs];
+#endif
+      tile_b[kk][nn] = v;
+    }
+    barrier();
+    for (int kk = 0; kk < BK; ++kk) {
+      float av[4], bv[4];
+      for (int i = 0; i < 4; ++i) av[i] = tile_a[kk][ty + 16 * i];
+      for (int j = 0; j < 4; ++j) bv[j] = tile_b[kk][tx + 16 * j];
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) acc[i][j] = fma(av[i], bv[j], acc[i][j]);
+    }
+    barrier();
+  }
+
+  for (int i = 0; i < 4; ++i) {
+    const int gm = row0 + ty + 16 * i;
+    if (gm >= M) continue;
+#ifdef IMPLICIT_CONV
+    const float bias = p.bias_off >= 0 ? a_data[p.bias_off + gm] : 0.0;
+    for (int j = 0; j < 4; ++j) {
+      const int gn = col0 + tx + 16 * j;
+      if (gn >= N) continue;
+      float v = p.alpha * acc[i][j] + bias;
+      if (p.add_off >= 0) v += d_data[p.add_off + gm * N + gn];
+      c_data[p.out_off + gm * N + gn] = activate(v, p.act);
+    }
+#else
+    const float bias = p.bias_off >= 0 ? a_data[p.bias_off + gm] : 0.0;
+    for (int j = 0; j < 4; ++j) {
+      const int gn = col0 + tx + 16 * j;
+      if (gn >= N) continue;
+      c_data[p.c_off + gm * p.c_rs + gn * p.c_cs] = activate(p.alpha * acc[i][j] + bias, p.act);
+    }
+#endif
+  }
+}

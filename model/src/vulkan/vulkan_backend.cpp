@@ -1,0 +1,59 @@
+#include "vulkan/vulkan_backend.hpp"
+
+#include "vulkan/device_weights.hpp"
+#include "vulkan/vulkan_instance.hpp"
+#include "vulkan/vulkan_network.hpp"
+
+namespace neuflow::model {
+
+struct VulkanContext {
+  std::shared_ptr<const vulkan::DeviceWeights> weights;
+};
+
+namespace {
+
+class VulkanBackend final : public InferenceBackend {
+ public:
+  VulkanBackend(std::shared_ptr<VulkanContext> context, int height, int width)
+      : context_(std::move(context)), network_(context_->weights, height, width) {}
+  int width() const override { return network_.width(); }
+  int height() const override { return network_.height(); }
+  void encode(const Tensor& image, int slot) override { network_.encode(image, slot); }
+  void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer) override {
+    network_.flow(slot0, slot1, iterations, out, observer);
+  }
+
+ private:
+  std::shared_ptr<VulkanContext> context_;
+  vulkan::VulkanNetwork network_;
+};
+
+}  // namespace
+
+std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>& model, int index) {
+  auto device = vulkan::VulkanDevice::open(index);
+  auto context = std::make_shared<VulkanContext>();
+  context->weights = vulkan::DeviceWeights::get(model, device);
+  return context;
+}
+
+std::string describe(const VulkanContext& context) { return context.weights->device->label(); }
+
+std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<VulkanContext>& context, int height,
+                                                      int width) {
+  return std::make_unique<VulkanBackend>(context, height, width);
+}
+
+int find_gpu_for_auto(int requested) {
+  try {
+    const auto devices = list_gpu_devices();
+    if (requested >= 0) return requested < static_cast<int>(devices.size()) ? requested : -1;
+    for (const auto& d : devices) {
+      if (d.is_gpu()) return d.index;
+    }
+  } catch (const BackendError&) {
+  }
+  return -1;
+}
+
+}  // namespace neuflow::model

@@ -1,0 +1,25 @@
+#pragma once
+// The Vulkan backend as FlowSession sees it: a device with the model's weights on it, opened
+// once per session, and a plan per model size. Builds without Vulkan (NEUFLOW_VULKAN=OFF)
+// link vulkan_unavailable.cpp instead, whose every call throws BackendError(unavailable).
+#include <memory>
+#include <string>
+
+#include "inference_backend.hpp"
+
+namespace neuflow::model {
+
+struct VulkanContext;
+
+// index -1: the first discrete or integrated GPU, else the first device. Throws BackendError.
+std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>& model, int index);
+// "vulkan device 0 (NVIDIA H200)".
+std::string describe(const VulkanContext& context);
+// Throws BackendError (out of memory, ...).
+std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<VulkanContext>& context, int height,
+                                                      int width);
+// For backend=auto: the index of the device to use (the given one, or the first discrete or
+// integrated GPU), or -1 when there is none (also without Vulkan at all).
+int find_gpu_for_auto(int requested);
+
+}  // namespace neuflow::model

@@ -1,0 +1,274 @@
+#include "vulkan/vulkan_device.hpp"
+
+#include <cstdlib>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "vulkan/vulkan_instance.hpp"
+
+namespace neuflow::model::vulkan {
+
+Buffer& Buffer::operator=(Buffer&& other) noexcept {
+  if (this != &other) {
+    if (device_) device_->release(*this);
+    device_ = std::move(other.device_);
+    buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    bytes_ = std::exchange(other.bytes_, 0);
+    mapped_ = std::exchange(other.mapped_, nullptr);
+  }
+  return *this;
+}
+
+Buffer::~Buffer() {
+  if (device_) device_->release(*this);
+}
+
+namespace {
+
+std::size_t budget_from_environment() {
+  const char* v = std::getenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB");
+  if (v == nullptr || *v == '\0') return 0;
+  char* end = nullptr;
+  const unsigned long long mb = std::strtoull(v, &end, 10);
+  return (end && *end == '\0') ? static_cast<std::size_t>(mb) << 20 : 0;
+}
+
+int pick_default(const std::vector<VkPhysicalDevice>& devices) {
+  for (std::size_t i = 0; i < devices.size(); ++i) {
+    if (describe(devices[i], static_cast<int>(i)).is_gpu()) return static_cast<int>(i);
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
+  static std::mutex mutex;
+  static std::map<int, std::weak_ptr<VulkanDevice>> opened;
+  const auto devices = physical_devices();
+  if (devices.empty()) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       "no Vulkan device: the loader found no driver with a device (install the GPU's Vulkan "
+                       "driver; `neuflow devices` lists what Vulkan sees)");
+  }
+  if (index < 0) index = pick_default(devices);
+  if (index >= static_cast<int>(devices.size())) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       "no Vulkan device " + std::to_string(index) + ": this machine has " +
+                           std::to_string(devices.size()) + " (0 to " + std::to_string(devices.size() - 1) +
+                           "; `neuflow devices` lists them)");
+  }
+  const std::lock_guard lock(mutex);
+  if (auto device = opened[index].lock(); device && !device->lost_) return device;
+  auto device = std::shared_ptr<VulkanDevice>(new VulkanDevice(devices[static_cast<std::size_t>(index)], index));
+  opened[index] = device;
+  return device;
+}
+
+VulkanDevice::VulkanDevice(VkPhysicalDevice physical, int index)
+    : physical_(physical), info_(describe(physical, index)), budget_(budget_from_environment()) {
+  label_ = "vulkan device " + std::to_string(index) + " (" + info_.name + ")";
+  vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(physical_, &props);
+  timestamp_period_ = props.limits.timestampPeriod;
+
+  uint32_t families = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> family(families);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, family.data());
+  bool found = false;
+  for (uint32_t f = 0; f < families && !found; ++f) {
+    if (family[f].queueFlags & VK_QUEUE_COMPUTE_BIT) {
+      queue_family_ = f;
+      found = true;
+    }
+  }
+  if (!found) throw BackendError(BackendError::Kind::unavailable, label_ + ": has no compute queue");
+
+  const float priority = 1.f;
+  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue.queueFamilyIndex = queue_family_;
+  queue.queueCount = 1;
+  queue.pQueuePriorities = &priority;
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue;
+  check(vkCreateDevice(physical_, &info, nullptr, &device_), "vkCreateDevice");
+  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  try {
+    create_pipelines();
+  } catch (...) {
+    destroy();
+    throw;
+  }
+}
+
+void VulkanDevice::create_pipelines() {
+  std::array<VkDescriptorSetLayoutBinding, kBindings> bindings{};
+  for (int b = 0; b < kBindings; ++b) {
+    bindings[b].binding = static_cast<uint32_t>(b);
+    bindings[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[b].descriptorCount = 1;
+    bindings[b].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo set{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  set.bindingCount = kBindings;
+  set.pBindings = bindings.data();
+  check(vkCreateDescriptorSetLayout(device_, &set, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, kPushConstantBytes};
+  VkPipelineLayoutCreateInfo layout{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layout.setLayoutCount = 1;
+  layout.pSetLayouts = &set_layout_;
+  layout.pushConstantRangeCount = 1;
+  layout.pPushConstantRanges = &push;
+  check(vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
+
+  for (std::size_t s = 0; s < kShaderCount; ++s) {
+    const auto shader = static_cast<Shader>(s);
+    const auto code = spirv(shader);
+    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    module_info.codeSize = code.size_bytes();
+    module_info.pCode = code.data();
+    VkShaderModule module = VK_NULL_HANDLE;
+    check(vkCreateShaderModule(device_, &module_info, nullptr, &module),
+          std::string("vkCreateShaderModule(") + shader_name(shader) + ")");
+    VkComputePipelineCreateInfo pipeline{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    pipeline.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    pipeline.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pipeline.stage.module = module;
+    pipeline.stage.pName = "main";
+    pipeline.layout = pipeline_layout_;
+    const VkResult r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline, nullptr, &pipelines_[s]);
+    vkDestroyShaderModule(device_, module, nullptr);
+    if (r != VK_SUCCESS) {
+      throw BackendError(BackendError::Kind::driver, label_ + ": the driver rejected the compute pipeline '" +
+                                                         shader_name(shader) + "': " + result_text(r));
+    }
+  }
+}
+
+VulkanDevice::~VulkanDevice() { destroy(); }
+
+void VulkanDevice::destroy() {
+  if (device_ == VK_NULL_HANDLE) return;
+  vkDeviceWaitIdle(device_);
+  for (VkPipeline& p : pipelines_) {
+    if (p != VK_NULL_HANDLE) vkDestroyPipeline(device_, p, nullptr);
+    p = VK_NULL_HANDLE;
+  }
+  if (pipeline_layout_ != VK_NULL_HANDLE) vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
+  if (set_layout_ != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+  pipeline_layout_ = VK_NULL_HANDLE;
+  set_layout_ = VK_NULL_HANDLE;
+  vkDestroyDevice(device_, nullptr);
+  device_ = VK_NULL_HANDLE;
+}
+
+void VulkanDevice::check(VkResult result, std::string_view call) const {
+  if (result == VK_SUCCESS) return;
+  vulkan::check(result, label_, call);
+}
+
+uint32_t VulkanDevice::memory_type(uint32_t allowed, Memory memory) const {
+  const VkMemoryPropertyFlags want =
+      memory == Memory::device ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
+      : memory == Memory::upload ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                 : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  // Read-backs prefer cached memory (reads from write-combined memory are slow).
+  const VkMemoryPropertyFlags prefer = memory == Memory::readback ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (uint32_t t = 0; t < memory_.memoryTypeCount; ++t) {
+      const VkMemoryPropertyFlags flags = memory_.memoryTypes[t].propertyFlags;
+      if (!(allowed & (1u << t)) || (flags & want) != want) continue;
+      if (pass == 0 && (flags & prefer) != prefer) continue;
+      return t;
+    }
+  }
+  throw BackendError(BackendError::Kind::driver, label_ + ": no memory type for a buffer");
+}
+
+Buffer VulkanDevice::create_buffer(std::size_t bytes, Memory memory, const std::string& what) {
+  bytes = std::max<std::size_t>(bytes, 16);
+  if (bytes > info_.max_buffer_bytes) {
+    throw BackendError(BackendError::Kind::out_of_memory,
+                       label_ + ": " + what + " needs " + std::to_string(bytes >> 20) +
+                           " MiB in one buffer, more than the device's maxStorageBufferRange (" +
+                           std::to_string(info_.max_buffer_bytes >> 20) + " MiB): use a smaller model size");
+  }
+  {
+    const std::lock_guard lock(memory_mutex_);
+    if (budget_ != 0 && allocated_ + bytes > budget_) {
+      throw BackendError(BackendError::Kind::out_of_memory,
+                         label_ + ": out of device memory allocating " + std::to_string((bytes + (1 << 20) - 1) >> 20) +
+                             " MiB for " + what + " (NEUFLOW_VULKAN_MEMORY_BUDGET_MB allows " +
+                             std::to_string(budget_ >> 20) + " MiB, " + std::to_string(allocated_ >> 20) +
+                             " MiB in use)");
+    }
+    allocated_ += bytes;
+  }
+  Buffer b;
+  b.device_ = shared_from_this();
+  b.bytes_ = bytes;
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = bytes;
+  info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  const auto fail = [&](VkResult r, const char* call) {
+    if (r == VK_SUCCESS) return;
+    throw BackendError(r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY
+                           ? BackendError::Kind::out_of_memory
+                           : BackendError::Kind::driver,
+                       label_ + ": " + call + " failed for " + what + " (" + std::to_string(bytes >> 20) +
+                           " MiB): " + result_text(r));
+  };
+  fail(vkCreateBuffer(device_, &info, nullptr, &b.buffer_), "vkCreateBuffer");
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device_, b.buffer_, &req);
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = memory_type(req.memoryTypeBits, memory);
+  fail(vkAllocateMemory(device_, &alloc, nullptr, &b.memory_), "vkAllocateMemory");
+  fail(vkBindBufferMemory(device_, b.buffer_, b.memory_, 0), "vkBindBufferMemory");
+  if (memory != Memory::device) fail(vkMapMemory(device_, b.memory_, 0, VK_WHOLE_SIZE, 0, &b.mapped_), "vkMapMemory");
+  return b;
+}
+
+void VulkanDevice::release(Buffer& b) {
+  if (b.mapped_) vkUnmapMemory(device_, b.memory_);
+  if (b.buffer_ != VK_NULL_HANDLE) vkDestroyBuffer(device_, b.buffer_, nullptr);
+  if (b.memory_ != VK_NULL_HANDLE) vkFreeMemory(device_, b.memory_, nullptr);
+  {
+    const std::lock_guard lock(memory_mutex_);
+    allocated_ -= std::min(allocated_, b.bytes_);
+  }
+  b.buffer_ = VK_NULL_HANDLE;
+  b.memory_ = VK_NULL_HANDLE;
+  b.mapped_ = nullptr;
+  b.bytes_ = 0;
+  b.device_.reset();  // last: may destroy this device
+}
+
+void VulkanDevice::submit_and_wait(VkCommandBuffer commands, VkFence fence) {
+  if (lost_) {
+    throw BackendError(BackendError::Kind::device_lost, label_ + ": the device was lost earlier; start a new session");
+  }
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &commands;
+  VkResult r;
+  {
+    // Sessions on one device share its queue, which Vulkan requires to be used by one thread
+    // at a time; the wait happens outside the lock so their work overlaps on the device.
+    const std::lock_guard lock(queue_mutex_);
+    r = vkQueueSubmit(queue_, 1, &submit, fence);
+  }
+  if (r == VK_SUCCESS) r = vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX);
+  if (r == VK_SUCCESS) r = vkResetFences(device_, 1, &fence);
+  if (r == VK_ERROR_DEVICE_LOST) lost_ = true;
+  check(r, "running the network (vkQueueSubmit/vkWaitForFences)");
+}
+
+}  // namespace neuflow::model::vulkan

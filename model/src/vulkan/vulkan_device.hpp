@@ -1,0 +1,105 @@
+#pragma once
+// One opened Vulkan device: its compute queue, memory, and the compute pipelines of every
+// shader, created once and shared by all sessions on that device (open() hands out the same
+// instance while anyone holds it).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+
+#include "vulkan/shaders.hpp"
+#include "vulkan/vulkan_api.hpp"
+
+namespace neuflow::model::vulkan {
+
+class VulkanDevice;
+
+// A storage buffer with its own memory: device-local for tensors, host-visible (mapped) for
+// uploads and read-backs. Move-only; released with the device kept alive by it.
+class Buffer {
+ public:
+  Buffer() = default;
+  Buffer(Buffer&& other) noexcept { *this = std::move(other); }
+  Buffer& operator=(Buffer&& other) noexcept;
+  ~Buffer();
+
+  VkBuffer handle() const { return buffer_; }
+  std::size_t bytes() const { return bytes_; }
+  float* mapped() const { return static_cast<float*>(mapped_); }
+  explicit operator bool() const { return buffer_ != VK_NULL_HANDLE; }
+
+ private:
+  friend class VulkanDevice;
+  std::shared_ptr<VulkanDevice> device_;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  std::size_t bytes_ = 0;
+  void* mapped_ = nullptr;
+};
+
+class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
+ public:
+  // index: a device of list_gpu_devices(); -1: the first discrete or integrated GPU, else the
+  // first device. Throws BackendError naming the device and the cause.
+  static std::shared_ptr<VulkanDevice> open(int index);
+
+  ~VulkanDevice();
+  VulkanDevice(const VulkanDevice&) = delete;
+  VulkanDevice& operator=(const VulkanDevice&) = delete;
+
+  const GpuDevice& info() const { return info_; }
+  // "vulkan device 0 (NVIDIA H200)": how errors and logs name it.
+  const std::string& label() const { return label_; }
+  VkDevice handle() const { return device_; }
+  uint32_t queue_family() const { return queue_family_; }
+  VkPipeline pipeline(Shader shader) const { return pipelines_[static_cast<std::size_t>(shader)]; }
+  VkPipelineLayout pipeline_layout() const { return pipeline_layout_; }
+  VkDescriptorSetLayout set_layout() const { return set_layout_; }
+  float timestamp_period_ns() const { return timestamp_period_; }
+
+  enum class Memory { device, upload, readback };
+  // `what` names the buffer in an out-of-memory error. Honours NEUFLOW_VULKAN_MEMORY_BUDGET_MB.
+  Buffer create_buffer(std::size_t bytes, Memory memory, const std::string& what);
+
+  // Submits and waits on `fence` (the caller's, unsignalled; left unsignalled). Throws
+  // BackendError (device lost, ...) naming the device. After a lost device every later call
+  // fails and open() creates a new device.
+  void submit_and_wait(VkCommandBuffer commands, VkFence fence);
+
+  // Throws if `where` failed, naming this device.
+  void check(VkResult result, std::string_view call) const;
+
+  // Every binding of every shader is one of these storage buffers.
+  static constexpr int kBindings = 4;
+  static constexpr std::size_t kPushConstantBytes = 128;
+
+ private:
+  friend class Buffer;
+  VulkanDevice(VkPhysicalDevice physical, int index);
+  void create_pipelines();
+  void destroy();
+  uint32_t memory_type(uint32_t allowed, Memory memory) const;
+  void release(Buffer& buffer);
+
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  GpuDevice info_;
+  std::string label_;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  VkPhysicalDeviceMemoryProperties memory_{};
+  float timestamp_period_ = 1.f;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
+  std::array<VkPipeline, kShaderCount> pipelines_{};
+  std::mutex queue_mutex_;
+  std::mutex memory_mutex_;
+  std::size_t allocated_ = 0;
+  std::size_t budget_ = 0;  // 0: no budget
+  bool lost_ = false;
+};
+
+}  // namespace neuflow::model::vulkan

@@ -1,0 +1,173 @@
+#include "vulkan/vulkan_instance.hpp"
+
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <string>
+
+namespace neuflow::model::vulkan {
+
+namespace {
+
+std::atomic<std::size_t> validation_messages{0};
+
+bool validation_requested() {
+  const char* v = std::getenv("NEUFLOW_VULKAN_VALIDATION");
+  return v != nullptr && *v != '\0' && std::strcmp(v, "0") != 0;
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                     VkDebugUtilsMessageTypeFlagsEXT,
+                                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+  const bool error = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) != 0;
+  ++validation_messages;
+  std::fprintf(stderr, "neuflow: Vulkan validation %s: %s\n", error ? "error" : "warning",
+               data && data->pMessage ? data->pMessage : "(no text)");
+  if (std::strcmp(std::getenv("NEUFLOW_VULKAN_VALIDATION"), "fatal") == 0) std::abort();
+  return VK_FALSE;
+}
+
+struct Instance {
+  VkInstance handle = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+};
+
+bool layer_available(const char* name) {
+  uint32_t count = 0;
+  vkEnumerateInstanceLayerProperties(&count, nullptr);
+  std::vector<VkLayerProperties> layers(count);
+  vkEnumerateInstanceLayerProperties(&count, layers.data());
+  for (const auto& l : layers) {
+    if (std::strcmp(l.layerName, name) == 0) return true;
+  }
+  return false;
+}
+
+Instance create_instance() {
+  if (volkInitialize() != VK_SUCCESS) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       "Vulkan is not available: the Vulkan loader (libvulkan.so.1) was not found; install it "
+                       "(Debian/Ubuntu: libvulkan1, plus a driver such as mesa-vulkan-drivers or the GPU vendor's)");
+  }
+  if (volkGetInstanceVersion() < VK_API_VERSION_1_1) {
+    throw BackendError(BackendError::Kind::unavailable, "Vulkan is not available: the loader is older than Vulkan 1.1");
+  }
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "neuflow";
+  app.pEngineName = "neuflow";
+  app.apiVersion = VK_API_VERSION_1_1;
+  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  info.pApplicationInfo = &app;
+  const char* layer = "VK_LAYER_KHRONOS_validation";
+  const char* extension = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+  const bool validate = validation_requested();
+  if (validate) {
+    if (!layer_available(layer)) {
+      throw BackendError(BackendError::Kind::unavailable,
+                         "NEUFLOW_VULKAN_VALIDATION is set but the Khronos validation layer is not installed "
+                         "(Debian: vulkan-validationlayers)");
+    }
+    info.enabledLayerCount = 1;
+    info.ppEnabledLayerNames = &layer;
+    info.enabledExtensionCount = 1;
+    info.ppEnabledExtensionNames = &extension;
+  }
+  Instance inst;
+  const VkResult r = vkCreateInstance(&info, nullptr, &inst.handle);
+  if (r != VK_SUCCESS) {
+    throw BackendError(BackendError::Kind::unavailable, "Vulkan is not available: vkCreateInstance failed: " + result_text(r));
+  }
+  volkLoadInstance(inst.handle);
+  if (validate) {
+    VkDebugUtilsMessengerCreateInfoEXT m{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    m.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    m.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    m.pfnUserCallback = on_validation_message;
+    check(vkCreateDebugUtilsMessengerEXT(inst.handle, &m, nullptr, &inst.messenger), "Vulkan", "vkCreateDebugUtilsMessengerEXT");
+  }
+  return inst;
+}
+
+std::string version_text(uint32_t v) {
+  return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+         std::to_string(VK_API_VERSION_PATCH(v));
+}
+
+}  // namespace
+
+VkInstance instance() {
+  // Created once; a failure is remembered so every later caller gets the same message.
+  static std::mutex mutex;
+  static Instance created;
+  static std::string failure;
+  const std::lock_guard lock(mutex);
+  if (created.handle != VK_NULL_HANDLE) return created.handle;
+  if (!failure.empty()) throw BackendError(BackendError::Kind::unavailable, failure);
+  try {
+    created = create_instance();
+  } catch (const BackendError& e) {
+    failure = e.what();
+    throw;
+  }
+  return created.handle;
+}
+
+std::vector<VkPhysicalDevice> physical_devices() {
+  VkInstance inst = instance();
+  uint32_t count = 0;
+  check(vkEnumeratePhysicalDevices(inst, &count, nullptr), "Vulkan", "vkEnumeratePhysicalDevices");
+  std::vector<VkPhysicalDevice> devices(count);
+  check(vkEnumeratePhysicalDevices(inst, &count, devices.data()), "Vulkan", "vkEnumeratePhysicalDevices");
+  devices.resize(count);
+  return devices;
+}
+
+GpuDevice describe(VkPhysicalDevice device, int index) {
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(device, &props);
+  VkPhysicalDeviceMemoryProperties memory;
+  vkGetPhysicalDeviceMemoryProperties(device, &memory);
+  VkPhysicalDeviceShaderFloat16Int8Features f16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_FLOAT16_INT8_FEATURES};
+  VkPhysicalDevice16BitStorageFeatures storage16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_16BIT_STORAGE_FEATURES};
+  storage16.pNext = &f16;
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  features.pNext = &storage16;
+  vkGetPhysicalDeviceFeatures2(device, &features);
+
+  GpuDevice d;
+  d.index = index;
+  d.name = props.deviceName;
+  switch (props.deviceType) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: d.type = "discrete"; break;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: d.type = "integrated"; break;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: d.type = "virtual"; break;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: d.type = "cpu"; break;
+    default: d.type = "other"; break;
+  }
+  d.api_version = version_text(props.apiVersion);
+  d.driver = "driver version " + std::to_string(props.driverVersion);
+  for (uint32_t h = 0; h < memory.memoryHeapCount; ++h) {
+    if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) d.memory_bytes += memory.memoryHeaps[h].size;
+  }
+  d.max_buffer_bytes = props.limits.maxStorageBufferRange;
+  d.fp16 = f16.shaderFloat16 && storage16.storageBuffer16BitAccess;
+  return d;
+}
+
+}  // namespace neuflow::model::vulkan
+
+namespace neuflow::model {
+
+std::vector<GpuDevice> list_gpu_devices() {
+  const auto devices = vulkan::physical_devices();
+  std::vector<GpuDevice> out;
+  for (std::size_t i = 0; i < devices.size(); ++i) out.push_back(vulkan::describe(devices[i], static_cast<int>(i)));
+  return out;
+}
+
+std::size_t vulkan_validation_message_count() { return vulkan::validation_messages.load(); }
+
+}  // namespace neuflow::model

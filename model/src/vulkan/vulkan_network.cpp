@@ -1,0 +1,589 @@
+#include "vulkan/vulkan_network.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "vulkan/one_shot_commands.hpp"
+
+namespace neuflow::model::vulkan {
+
+namespace {
+
+constexpr int kDim = 192;          // attention tokens' width
+constexpr int kContext = 64;       // channels 0..63 of the attention output and of f8
+constexpr int kFeatures = 128;     // channels 64..191
+constexpr int kCorr = 81, kHidden = 64;
+constexpr int kHiddenOffset = kCorr, kFlowOffset = kCorr + kHidden, kRefineInput = kCorr + kHidden + 2;
+// The attention's and matching's score blocks hold at most this many floats (32 MiB), well
+// inside lavapipe's 128 MiB per buffer, so memory stays O(L · block) at any size.
+constexpr int kScoreBlockFloats = 8 << 20;
+constexpr int kLocal = 256;        // invocations per workgroup of the element-wise shaders
+
+enum Act { kNone = 0, kLeakyRelu = 1, kRelu = 2, kGelu = 3 };
+
+struct ConvPush {
+  int in_c, in_h, in_w, in_off, out_c, out_h, out_w, out_off, kernel, stride, pad, act, w_off, bias_off, add_off;
+  float alpha;
+};
+struct MatmulPush {
+  int m, n, k, a_off, a_rs, a_cs, b_off, b_rs, b_cs, c_off, c_rs, c_cs, bias_off, act;
+  float alpha;
+};
+
+uint32_t groups(long count, long per_group) {
+  return static_cast<uint32_t>(std::clamp<long>((count + per_group - 1) / per_group, 1, 65535));
+}
+
+}  // namespace
+
+// Records one pass: every command is preceded by a barrier that orders it after everything
+// before it (the network is a chain; there is little to overlap inside one pass). With an
+// observer, observe() ends the command buffer, runs it, reads the tensor back and goes on in
+// a fresh recording.
+class VulkanNetwork::Recorder {
+ public:
+  Recorder(VulkanNetwork& net, VkCommandBuffer commands, const StageObserver* observer)
+      : net_(net), commands_(commands), observer_(observer && *observer ? observer : nullptr) {
+    begin();
+  }
+
+  void begin() {
+    net_.device_.check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
+    VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    net_.device_.check(vkBeginCommandBuffer(commands_, &info), "vkBeginCommandBuffer");
+  }
+  void end() { net_.device_.check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer"); }
+  void run() {
+    end();
+    net_.device_.submit_and_wait(commands_, net_.fence_);
+  }
+
+  void barrier() {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                      VK_ACCESS_TRANSFER_WRITE_BIT;
+    const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    vkCmdPipelineBarrier(commands_, stages, stages, 0, 1, &b, 0, nullptr, 0, nullptr);
+  }
+
+  void dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
+                uint32_t gx, uint32_t gy = 1) {
+    barrier();
+    std::array<VkBuffer, 4> handles{};
+    for (std::size_t i = 0; i < handles.size(); ++i) {
+      handles[i] = (bindings[i] ? *bindings[i] : net_.dummy_).handle();
+    }
+    VkDescriptorSet set = net_.descriptor_set(handles);
+    vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader));
+    vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline_layout(), 0, 1, &set, 0,
+                            nullptr);
+    vkCmdPushConstants(commands_, net_.device_.pipeline_layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       static_cast<uint32_t>(bytes), push);
+    vkCmdDispatch(commands_, gx, gy, 1);
+  }
+
+  void copy(const View& src, const View& dst) {
+    barrier();
+    const VkBufferCopy region{static_cast<VkDeviceSize>(src.offset()) * 4, static_cast<VkDeviceSize>(dst.offset()) * 4,
+                              static_cast<VkDeviceSize>(src.count()) * 4};
+    vkCmdCopyBuffer(commands_, src.buffer->handle(), dst.buffer->handle(), 1, &region);
+  }
+  void copy_raw(const Buffer& src, const Buffer& dst, std::size_t floats, std::size_t dst_offset = 0) {
+    barrier();
+    const VkBufferCopy region{0, dst_offset * 4, floats * 4};
+    vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), 1, &region);
+  }
+  void fill(const View& dst, float value) {
+    barrier();
+    uint32_t bits;
+    std::memcpy(&bits, &value, 4);
+    vkCmdFillBuffer(commands_, dst.buffer->handle(), static_cast<VkDeviceSize>(dst.offset()) * 4,
+                    static_cast<VkDeviceSize>(dst.count()) * 4, bits);
+  }
+
+  // out = act(conv(in) + bias (+ addend)); out.c must be the layer's output channels.
+  void conv(const DeviceConv& w, const View& in, int stride, int pad, Act act, const View& out,
+            const View* addend = nullptr) {
+    ConvPush p{in.c, in.h, in.w, in.offset(), out.c, out.h, out.w, out.offset(), w.kernel, stride, pad, act,
+               w.weight, w.bias, addend ? addend->offset() : -1, 1.f};
+    dispatch(Shader::conv2d, {&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, &p,
+             sizeof p, groups(static_cast<long>(out.h) * out.w, 64), groups(out.c, 64));
+  }
+
+  // Token lists [features][tokens]: out = act(W · in + b).
+  void linear(const DeviceLinear& w, const Buffer& in, int in_off, const Buffer& out, int out_off, int tokens,
+              Act act = kNone) {
+    MatmulPush p{w.out_features, tokens, w.in_features, w.weight, w.in_features, 1, in_off, tokens, 1,
+                 out_off, tokens, 1, w.bias, act, 1.f};
+    dispatch(Shader::matmul, {&net_.weights_->buffer, &in, &out, nullptr}, &p, sizeof p, groups(tokens, 64),
+             groups(w.out_features, 64));
+  }
+
+  void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulPush& p) {
+    dispatch(Shader::matmul, {&a, &b, &c, nullptr}, &p, sizeof p, groups(p.n, 64), groups(p.m, 64));
+  }
+
+  void resample(const View& src, const View& dst, int factor, bool relu, float scale) {
+    struct {
+      int channels, in_h, in_w, in_off, out_off, factor, relu;
+      float scale;
+    } p{src.c, src.h, src.w, src.offset(), dst.offset(), factor, relu ? 1 : 0, scale};
+    dispatch(Shader::resample, {src.buffer, nullptr, dst.buffer, nullptr}, &p, sizeof p,
+             groups(static_cast<long>(dst.count()), kLocal));
+  }
+
+  void avgpool(const View& src, const View& dst) {
+    struct {
+      int channels, in_h, in_w;
+    } p{src.c, src.h, src.w};
+    dispatch(Shader::avgpool2x, {src.buffer, nullptr, dst.buffer, nullptr}, &p, sizeof p,
+             groups(static_cast<long>(dst.count()), kLocal));
+  }
+
+  void axpby(float a, const View& x, float b, const View& y, const View& out) {
+    struct {
+      int count, x_off, y_off, out_off;
+      float a, b;
+    } p{out.count(), x.offset(), y.offset(), out.offset(), a, b};
+    dispatch(Shader::axpby, {x.buffer, y.buffer, out.buffer, nullptr}, &p, sizeof p, groups(out.count(), kLocal));
+  }
+
+  // Reads `v` back and hands it to the observer as NHWC (only when observing).
+  void observe(const std::string& name, int frame, const View& v) {
+    if (!observer_) return;
+    barrier();
+    const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * 4, 0, static_cast<VkDeviceSize>(v.count()) * 4};
+    vkCmdCopyBuffer(commands_, v.buffer->handle(), net_.readback_.handle(), 1, &region);
+    run();
+    const float* planar = net_.readback_.mapped();
+    const std::size_t plane = static_cast<std::size_t>(v.h) * v.w;
+    nhwc_.resize(plane * v.c);
+    for (int c = 0; c < v.c; ++c) {
+      for (std::size_t p = 0; p < plane; ++p) nhwc_[p * v.c + c] = planar[c * plane + p];
+    }
+    (*observer_)(StageTensor{name, frame, v.h, v.w, v.c, nhwc_.data()});
+    begin();
+  }
+  bool observing() const { return observer_ != nullptr; }
+
+ private:
+  VulkanNetwork& net_;
+  VkCommandBuffer commands_;
+  const StageObserver* observer_;
+  std::vector<float> nhwc_;
+};
+
+VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width)
+    : weights_(std::move(weights)),
+      device_(*weights_->device),
+      height_(height),
+      width_(width),
+      h8_(height / 8),
+      w8_(width / 8),
+      h16_(height / 16),
+      w16_(width / 16),
+      tokens_(h16_ * w16_) {
+  block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
+  const std::size_t hw = static_cast<std::size_t>(height) * width, hw8 = static_cast<std::size_t>(h8_) * w8_;
+  const std::size_t l = tokens_;
+  using M = VulkanDevice::Memory;
+  const auto make = [&](std::size_t floats, const char* what, M memory = M::device) {
+    return device_.create_buffer(floats * sizeof(float), memory, std::string(what) + " at " + std::to_string(width) +
+                                                                     "x" + std::to_string(height));
+  };
+  dummy_ = make(4, "a placeholder binding");
+  upload_ = make(3 * hw, "the frame upload", M::upload);
+  readback_ = make(std::max(192 * hw8, 2 * hw), "the read-back buffer", M::readback);
+  input_ = make(3 * hw, "the input frame");
+  half_ = make(3 * hw / 4, "the 1/2 frame");
+  quarter_ = make(3 * hw / 16, "the 1/4 frame");
+  eighth_ = make(3 * hw / 64, "the 1/8 frame");
+  encode_tmp_ = make(256 * hw8, "the backbone's scratch");
+  cat8_ = make(384 * hw8, "the 1/8 concatenation");
+  cat16_ = make(256 * l, "the 1/16 concatenation");
+  for (auto& s : slots_) {
+    s.f8 = make(192 * hw8, "frame features at 1/8");
+    s.f16 = make(192 * l, "frame features at 1/16");
+    s.up = make(128 * hw8, "the upsampler's frame features");
+  }
+  q_ = make(kDim * l, "attention queries");
+  k_ = make(kDim * l, "attention keys");
+  v_ = make(kDim * l, "attention values");
+  scores_ = make(static_cast<std::size_t>(block_rows_) * l, "a block of attention scores");
+  message_ = make(kDim * l, "attention messages");
+  attn_tmp_ = make(kDim * l, "attention scratch");
+  mlp_in_ = make(2 * kDim * l, "the attention MLP's input");
+  mlp_hidden_ = make(2 * kDim * l, "the attention MLP's hidden layer");
+  state0_ = make(kDim * l, "attention layer 0, frame 0");
+  state1_ = make(kDim * l, "attention layer 0, frame 1");
+  for (auto& a : attended_) a = make(kDim * l, "attention output");
+  grid_ = make(2 * l, "the matching grid");
+  correspondence_ = make(2 * l, "matching correspondences");
+  flow16_ = make(2 * l, "flow at 1/16");
+  flow8_ = make(2 * hw8, "flow at 1/8");
+  const auto make_refine = [&](Refine& r, std::size_t plane) {
+    r.input = make(kRefineInput * plane, "the refinement input");
+    r.constant_in = make((kContext + 1) * plane, "the refinement's constant input");
+    r.constant_out = make(128 * plane, "the refinement's constant part");
+    r.xa = make(128 * plane, "refinement scratch");
+    r.xb = make(128 * plane, "refinement scratch");
+    r.out66 = make(66 * plane, "the refinement output");
+  };
+  make_refine(refine16_, l);
+  make_refine(refine8_, hw8);
+  feature_in_ = make(256 * hw8, "the 1/8 feature merge input");
+  merge_tmp_ = make(128 * hw8, "merge scratch");
+  context_in_ = make(128 * hw8, "the context merge input");
+  context_tmp_ = make(64 * hw8, "context merge scratch");
+  for (auto& f : features8_) f = make(128 * hw8, "merged features at 1/8");
+  upsample_in_ = make(130 * hw8, "the upsampler input");
+  upsample1_ = make(256 * hw8, "the upsampler's first layer");
+  upsample2_ = make(512 * hw8, "the upsampler's second layer");
+  mask_ = make(576 * hw8, "the upsampling mask");
+  flow_full_ = make(2 * hw, "the full-resolution flow");
+
+  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool.queueFamilyIndex = device_.queue_family();
+  device_.check(vkCreateCommandPool(device_.handle(), &pool, nullptr, &pool_), "vkCreateCommandPool");
+  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  device_.check(vkCreateFence(device_.handle(), &fence, nullptr, &fence_), "vkCreateFence");
+  initialise_constants();
+}
+
+VulkanNetwork::~VulkanNetwork() {
+  VkDevice d = device_.handle();
+  if (fence_ != VK_NULL_HANDLE) vkDestroyFence(d, fence_, nullptr);
+  if (pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(d, pool_, nullptr);  // frees its command buffers
+  for (VkDescriptorPool p : descriptor_pools_) vkDestroyDescriptorPool(d, p, nullptr);
+}
+
+// What no pass writes: the position channels of f16, the matching grid, the radius planes.
+void VulkanNetwork::initialise_constants() {
+  const std::size_t l = tokens_;
+  Buffer staging = device_.create_buffer(4 * l * sizeof(float), VulkanDevice::Memory::upload, "constants");
+  float* c = staging.mapped();
+  for (int y = 0; y < h16_; ++y) {
+    for (int x = 0; x < w16_; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * w16_ + x;
+      c[p] = static_cast<float>(y) - static_cast<float>(h16_) / 2.f;            // f16 channel 190
+      c[l + p] = static_cast<float>(x) - static_cast<float>(w16_) / 2.f;        // f16 channel 191
+      c[2 * l + p] = static_cast<float>(x);                                     // grid x
+      c[3 * l + p] = static_cast<float>(y);                                     // grid y
+    }
+  }
+  OneShotCommands commands(device_);
+  VkCommandBuffer cb = commands.buffer();
+  for (auto& s : slots_) {
+    const VkBufferCopy pos{0, 190 * l * 4, 2 * l * 4};
+    vkCmdCopyBuffer(cb, staging.handle(), s.f16.handle(), 1, &pos);
+  }
+  const VkBufferCopy grid{2 * l * 4, 0, 2 * l * 4};
+  vkCmdCopyBuffer(cb, staging.handle(), grid_.handle(), 1, &grid);
+  const float radius = 4.f;
+  uint32_t bits;
+  std::memcpy(&bits, &radius, 4);
+  const std::size_t hw8 = static_cast<std::size_t>(h8_) * w8_;
+  vkCmdFillBuffer(cb, refine16_.constant_in.handle(), kContext * l * 4, l * 4, bits);
+  vkCmdFillBuffer(cb, refine8_.constant_in.handle(), kContext * hw8 * 4, hw8 * 4, bits);
+  commands.run();
+}
+
+VkDescriptorSet VulkanNetwork::descriptor_set(const std::array<VkBuffer, 4>& buffers) {
+  if (auto it = descriptor_sets_.find(buffers); it != descriptor_sets_.end()) return it->second;
+  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc.descriptorSetCount = 1;
+  VkDescriptorSetLayout layout = device_.set_layout();
+  alloc.pSetLayouts = &layout;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  VkResult r = VK_ERROR_OUT_OF_POOL_MEMORY;
+  if (!descriptor_pools_.empty()) {
+    alloc.descriptorPool = descriptor_pools_.back();
+    r = vkAllocateDescriptorSets(device_.handle(), &alloc, &set);
+  }
+  if (r == VK_ERROR_OUT_OF_POOL_MEMORY || r == VK_ERROR_FRAGMENTED_POOL) {
+    constexpr uint32_t kSets = 256;
+    const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSets * VulkanDevice::kBindings};
+    VkDescriptorPoolCreateInfo pool{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pool.maxSets = kSets;
+    pool.poolSizeCount = 1;
+    pool.pPoolSizes = &size;
+    VkDescriptorPool created = VK_NULL_HANDLE;
+    device_.check(vkCreateDescriptorPool(device_.handle(), &pool, nullptr, &created), "vkCreateDescriptorPool");
+    descriptor_pools_.push_back(created);
+    alloc.descriptorPool = created;
+    r = vkAllocateDescriptorSets(device_.handle(), &alloc, &set);
+  }
+  device_.check(r, "vkAllocateDescriptorSets");
+  std::array<VkDescriptorBufferInfo, 4> infos{};
+  std::array<VkWriteDescriptorSet, 4> writes{};
+  for (std::size_t i = 0; i < buffers.size(); ++i) {
+    infos[i] = {buffers[i], 0, VK_WHOLE_SIZE};
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set;
+    writes[i].dstBinding = static_cast<uint32_t>(i);
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(device_.handle(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  descriptor_sets_.emplace(buffers, set);
+  return set;
+}
+
+namespace {
+VkCommandBuffer allocate_commands(VulkanDevice& device, VkCommandPool pool) {
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = pool;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cb = VK_NULL_HANDLE;
+  device.check(vkAllocateCommandBuffers(device.handle(), &alloc, &cb), "vkAllocateCommandBuffers");
+  return cb;
+}
+}  // namespace
+
+VkCommandBuffer VulkanNetwork::cached(const std::string& key, int slot0, int slot1, const Iterations* iterations) {
+  if (auto it = command_buffers_.find(key); it != command_buffers_.end()) return it->second;
+  VkCommandBuffer cb = allocate_commands(device_, pool_);
+  try {
+    Recorder r(*this, cb, nullptr);
+    if (iterations) {
+      record_flow(r, slot0, slot1, *iterations);
+    } else {
+      record_encode(r, slot0);
+    }
+    r.end();
+  } catch (...) {
+    vkFreeCommandBuffers(device_.handle(), pool_, 1, &cb);
+    throw;
+  }
+  command_buffers_.emplace(key, cb);
+  return cb;
+}
+
+void VulkanNetwork::encode(const Tensor& image, int slot) {
+  // Planar upload: the device layout is [C][H][W].
+  float* dst = upload_.mapped();
+  const std::size_t hw = static_cast<std::size_t>(height_) * width_;
+  for (std::size_t p = 0; p < hw; ++p) {
+    dst[p] = image.data[3 * p];
+    dst[hw + p] = image.data[3 * p + 1];
+    dst[2 * hw + p] = image.data[3 * p + 2];
+  }
+  device_.submit_and_wait(cached("encode" + std::to_string(slot), slot, 0, nullptr), fence_);
+}
+
+void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,
+                         const StageObserver* observer) {
+  if (observer && *observer) {
+    if (observed_commands_ == VK_NULL_HANDLE) observed_commands_ = allocate_commands(device_, pool_);
+    Recorder r(*this, observed_commands_, observer);
+    record_flow(r, slot0, slot1, iterations);
+    r.run();
+  } else {
+    const std::string key = "flow" + std::to_string(slot0) + std::to_string(slot1) + ":" +
+                            std::to_string(iterations.s16) + ":" + std::to_string(iterations.s8);
+    device_.submit_and_wait(cached(key, slot0, slot1, &iterations), fence_);
+  }
+  out.resize(height_, width_, 2);
+  const float* planar = readback_.mapped();
+  const std::size_t hw = static_cast<std::size_t>(height_) * width_;
+  for (std::size_t p = 0; p < hw; ++p) {
+    out.data[2 * p] = planar[p];
+    out.data[2 * p + 1] = planar[hw + p];
+  }
+  if (observer && *observer) (*observer)(StageTensor{"flow", 0, height_, width_, 2, out.data.data()});
+}
+
+void VulkanNetwork::record_encode(Recorder& r, int slot) {
+  const int h = height_, w = width_;
+  const View input{&input_, 0, 3, h, w}, half{&half_, 0, 3, h / 2, w / 2}, quarter{&quarter_, 0, 3, h / 4, w / 4},
+      eighth{&eighth_, 0, 3, h / 8, w / 8};
+  r.copy_raw(upload_, input_, static_cast<std::size_t>(3) * h * w);
+  r.avgpool(input, half);
+  r.avgpool(half, quarter);
+  r.avgpool(quarter, eighth);
+  const auto& wt = *weights_;
+  Slot& s = slots_[static_cast<std::size_t>(slot)];
+  const auto block = [&](const DeviceBlock& b, const View& in, int stride, int pad, const View& out) {
+    const View tmp{&encode_tmp_, 0, b.conv1.out_channels, out.h, out.w};
+    r.conv(b.conv1, in, stride, pad, kLeakyRelu, tmp);
+    r.conv(b.conv2, tmp, 1, 1, kLeakyRelu, out);
+  };
+  const View cat8{&cat8_, 0, 384, h8_, w8_}, f8{&s.f8, 0, 192, h8_, w8_};
+  block(wt.block_8_1, half, 4, 2, cat8.channels(0, 256));
+  block(wt.block_8_2, quarter, 2, 2, cat8.channels(256, 128));
+  block(wt.block_cat_8, cat8, 1, 1, f8);
+  const View cat16{&cat16_, 0, 256, h16_, w16_};
+  block(wt.block_16_1, eighth, 2, 2, cat16.channels(0, 128));
+  block(wt.block_8_16, f8, 2, 2, cat16.channels(128, 128));
+  block(wt.block_cat_16, cat16, 1, 1, View{&s.f16, 0, 190, h16_, w16_});
+  block(wt.conv_s8, input, 8, 0, View{&s.up, 0, 128, h8_, w8_});
+}
+
+void VulkanNetwork::record_attention_layer(Recorder& r, const DeviceAttentionLayer& w, const Buffer& src,
+                                           const Buffer& tgt, const Buffer& out) {
+  const int l = tokens_;
+  r.linear(w.q_proj, src, 0, q_, 0, l);  // already scaled by 1/sqrt(192)
+  r.linear(w.k_proj, tgt, 0, k_, 0, l);
+  r.linear(w.v_proj, tgt, 0, v_, 0, l);
+  for (int r0 = 0; r0 < l; r0 += block_rows_) {
+    const int n = std::min(block_rows_, l - r0);
+    // scores[i][j] = q[:, r0 + i] · k[:, j]
+    r.matmul(q_, k_, scores_, {n, l, kDim, r0, 1, l, 0, l, 1, 0, l, 1, -1, kNone, 1.f});
+    struct {
+      int rows, cols, off;
+    } sp{n, l, 0};
+    r.dispatch(Shader::softmax_rows, {nullptr, nullptr, &scores_, nullptr}, &sp, sizeof sp, static_cast<uint32_t>(n));
+    // message[:, r0 + i] = v · scores[i]^T
+    r.matmul(v_, scores_, message_, {kDim, n, l, 0, l, 1, 0, 1, l, r0, l, 1, -1, kNone, 1.f});
+  }
+  r.linear(w.merge, message_, 0, attn_tmp_, 0, l);
+  const auto layer_norm = [&](const DeviceLayerNorm& nw, const Buffer& x, const Buffer& dst, int dst_off,
+                              const Buffer* residual) {
+    struct {
+      int dim, tokens, x_off, out_off, res_off, gamma_off, beta_off;
+    } p{kDim, l, 0, dst_off, residual ? 0 : -1, nw.gamma, nw.beta};
+    r.dispatch(Shader::layer_norm, {&weights_->buffer, &x, &dst, residual}, &p, sizeof p, groups(l, kLocal));
+  };
+  // mlp input = concat[src, LayerNorm1(merge(message))]
+  layer_norm(w.norm1, attn_tmp_, mlp_in_, kDim * l, nullptr);
+  r.copy(View{&src, 0, kDim, 1, l}, View{&mlp_in_, 0, kDim, 1, l});
+  r.linear(w.mlp0, mlp_in_, 0, mlp_hidden_, 0, l, kGelu);
+  r.linear(w.mlp2, mlp_hidden_, 0, attn_tmp_, 0, l);
+  layer_norm(w.norm2, attn_tmp_, out, 0, &src);
+}
+
+void VulkanNetwork::record_refinement(Recorder& r, const DeviceRefine& w, Refine& b, const View& f0, const View& f1,
+                                      const View& flow, int iterations, const std::string& scale) {
+  const int h = flow.h, wd = flow.w;
+  const View input{&b.input, 0, kRefineInput, h, wd};
+  const View constant_out{&b.constant_out, 0, 128, h, wd};
+  r.conv(w.conv1_constant, View{&b.constant_in, 0, kContext + 1, h, wd}, 1, 1, kNone, constant_out);
+  r.fill(input.channels(kHiddenOffset, kHidden), 0.f);
+  r.copy(flow, input.channels(kFlowOffset, 2));
+  const int inter = w.conv2.out_channels;
+  for (int i = 0; i < iterations; ++i) {
+    struct {
+      int h, w, channels, f0_off, f1_off, flow_off, out_off;
+    } cp{h, wd, f0.c, f0.offset(), f1.offset(), flow.offset(), 0};
+    r.dispatch(Shader::local_correlation, {f0.buffer, f1.buffer, &b.input, flow.buffer}, &cp, sizeof cp,
+               groups(static_cast<long>(h) * wd, kLocal));
+    const View xa{&b.xa, 0, 128, h, wd};
+    r.conv(w.conv1_dynamic, input, 1, 1, kLeakyRelu, xa, &constant_out);
+    View x{&b.xb, 0, inter, h, wd}, y{&b.xa, 0, inter, h, wd};
+    r.conv(w.conv2, xa, 1, 1, kLeakyRelu, x);
+    for (const auto& layer : w.conv_layers) {
+      r.conv(layer, x, 1, 1, kLeakyRelu, y);
+      std::swap(x, y);
+    }
+    const View out66{&b.out66, 0, 66, h, wd};
+    r.conv(w.conv3, x, 1, 1, kNone, out66);
+    struct {
+      int plane, hidden_off, flow_in_off, flow_off;
+    } up{h * wd, input.channels(kHiddenOffset, 1).offset(), input.channels(kFlowOffset, 1).offset(), flow.offset()};
+    r.dispatch(Shader::refine_update, {&b.out66, nullptr, &b.input, flow.buffer}, &up, sizeof up,
+               groups(static_cast<long>(h) * wd, kLocal));
+    if (r.observing()) {
+      const std::string it = "_iter" + std::to_string(i);
+      r.observe("corr_" + scale + it, 0, input.channels(0, kCorr));
+      r.observe("refine_" + scale + it + "_hidden", 0, input.channels(kHiddenOffset, kHidden));
+      r.observe("refine_" + scale + it + "_delta", 0, out66.channels(0, 2));
+    }
+  }
+}
+
+void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterations& iterations) {
+  const Slot& s0 = slots_[static_cast<std::size_t>(slot0)];
+  const Slot& s1 = slots_[static_cast<std::size_t>(slot1)];
+  const auto& wt = *weights_;
+  const int l = tokens_;
+  r.observe("backbone_s16", 0, View{&s0.f16, 0, 192, h16_, w16_});
+  r.observe("backbone_s16", 1, View{&s1.f16, 0, 192, h16_, w16_});
+  r.observe("backbone_s8", 0, View{&s0.f8, 0, 192, h8_, w8_});
+  r.observe("backbone_s8", 1, View{&s1.f8, 0, 192, h8_, w8_});
+  r.observe("conv_s8", 0, View{&s0.up, 0, 128, h8_, w8_});
+
+  // 1/16: cross-attention (layer 1 reads layer 0's outputs of both frames), then its BatchNorm.
+  record_attention_layer(r, wt.attention[0], s0.f16, s1.f16, state0_);
+  record_attention_layer(r, wt.attention[0], s1.f16, s0.f16, state1_);
+  record_attention_layer(r, wt.attention[1], state0_, state1_, attended_[0]);
+  record_attention_layer(r, wt.attention[1], state1_, state0_, attended_[1]);
+  for (const auto& a : attended_) {
+    struct {
+      int channels, plane, x_off, scale_off, shift_off;
+    } p{kDim, l, 0, wt.attention_norm_scale, wt.attention_norm_shift};
+    r.dispatch(Shader::channel_affine, {&wt.buffer, nullptr, &a, nullptr}, &p, sizeof p, groups(kDim * l, kLocal));
+  }
+  const View att0{&attended_[0], 0, kDim, h16_, w16_}, att1{&attended_[1], 0, kDim, h16_, w16_};
+  r.observe("cross_attn_s16", 0, att0);
+  r.observe("cross_attn_s16", 1, att1);
+
+  // Global matching: softmax(F0 F1^T / sqrt(128)) G - G, in blocks of rows.
+  const View feat0 = att0.channels(kContext, kFeatures), feat1 = att1.channels(kContext, kFeatures);
+  const float alpha = 1.f / std::sqrt(static_cast<float>(kFeatures));
+  for (int r0 = 0; r0 < l; r0 += block_rows_) {
+    const int n = std::min(block_rows_, l - r0);
+    r.matmul(attended_[0], attended_[1], scores_,
+             {n, l, kFeatures, feat0.offset() + r0, 1, l, feat1.offset(), l, 1, 0, l, 1, -1, kNone, alpha});
+    struct {
+      int rows, cols, off;
+    } sp{n, l, 0};
+    r.dispatch(Shader::softmax_rows, {nullptr, nullptr, &scores_, nullptr}, &sp, sizeof sp, static_cast<uint32_t>(n));
+    r.matmul(grid_, scores_, correspondence_, {2, n, l, 0, l, 1, 0, 1, l, r0, l, 1, -1, kNone, 1.f});
+  }
+  const View flow16{&flow16_, 0, 2, h16_, w16_};
+  r.axpby(1.f, View{&correspondence_, 0, 2, h16_, w16_}, -1.f, View{&grid_, 0, 2, h16_, w16_}, flow16);
+  r.observe("global_matching_flow", 0, flow16);
+
+  // 1/16 refinement with ctx16 = relu(context of frame 0).
+  r.resample(att0.channels(0, kContext), View{&refine16_.constant_in, 0, kContext, h16_, w16_}, 1, true, 1.f);
+  record_refinement(r, wt.refine_s16, refine16_, feat0, feat1, flow16, iterations.s16, "s16");
+
+  // 1/16 → 1/8.
+  const View flow8{&flow8_, 0, 2, h8_, w8_};
+  r.resample(flow16, flow8, 2, false, 2.f);
+  const std::array<const Slot*, 2> frames{&s0, &s1};
+  for (int f = 0; f < 2; ++f) {
+    const View in{&feature_in_, 0, 256, h8_, w8_};
+    r.copy(View{&frames[f]->f8, kContext, kFeatures, h8_, w8_}, in.channels(0, kFeatures));
+    r.resample(View{&attended_[f], kContext, kFeatures, h16_, w16_}, in.channels(kFeatures, kFeatures), 2, false, 1.f);
+    const View tmp{&merge_tmp_, 0, 128, h8_, w8_};
+    r.conv(wt.merge_s8_0, in, 1, 1, kGelu, tmp);
+    r.conv(wt.merge_s8_2, tmp, 1, 1, kNone, View{&features8_[f], 0, 128, h8_, w8_});
+  }
+  r.observe("merge_s8", 0, View{&features8_[0], 0, 128, h8_, w8_});
+  r.observe("merge_s8", 1, View{&features8_[1], 0, 128, h8_, w8_});
+  const View ctx_in{&context_in_, 0, 128, h8_, w8_};
+  r.resample(View{&s0.f8, 0, kContext, h8_, w8_}, ctx_in.channels(0, kContext), 1, true, 1.f);
+  r.resample(att0.channels(0, kContext), ctx_in.channels(kContext, kContext), 2, true, 1.f);
+  const View ctx_tmp{&context_tmp_, 0, 64, h8_, w8_};
+  r.conv(wt.context_merge_s8_0, ctx_in, 1, 1, kGelu, ctx_tmp);
+  const View ctx8{&refine8_.constant_in, 0, kContext, h8_, w8_};
+  r.conv(wt.context_merge_s8_2, ctx_tmp, 1, 1, kNone, ctx8);
+  r.observe("context_merge_s8", 0, ctx8);
+
+  // 1/8 refinement.
+  record_refinement(r, wt.refine_s8, refine8_, View{&features8_[0], 0, 128, h8_, w8_},
+                    View{&features8_[1], 0, 128, h8_, w8_}, flow8, iterations.s8, "s8");
+
+  // Convex upsampling.
+  const View up_in{&upsample_in_, 0, 130, h8_, w8_};
+  r.copy(flow8, up_in.channels(0, 2));
+  r.copy(View{&s0.up, 0, 128, h8_, w8_}, up_in.channels(2, 128));
+  const View u1{&upsample1_, 0, 256, h8_, w8_}, u2{&upsample2_, 0, 512, h8_, w8_}, mask{&mask_, 0, 576, h8_, w8_};
+  r.conv(wt.upsample_conv1, up_in, 1, 1, kRelu, u1);
+  r.conv(wt.upsample_conv2, u1, 1, 1, kRelu, u2);
+  r.conv(wt.upsample_conv3, u2, 1, 0, kNone, mask);
+  struct {
+    int h8, w8;
+  } cp{h8_, w8_};
+  r.dispatch(Shader::convex_upsample, {&mask_, &flow8_, &flow_full_, nullptr}, &cp, sizeof cp,
+             groups(static_cast<long>(height_) * width_, kLocal));
+  r.copy_raw(flow_full_, readback_, static_cast<std::size_t>(2) * height_ * width_);
+}
+
+}  // namespace neuflow::model::vulkan

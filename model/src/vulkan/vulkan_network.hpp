@@ -1,0 +1,90 @@
+#pragma once
+// The whole forward pass on a Vulkan device at one model resolution: every buffer, descriptor
+// set and command buffer is created once here; a pass replays a command buffer recorded the
+// first time that pass (encode into a slot, or flow between two slots with given iterations)
+// was asked for. With an observer the pass is recorded anew, stopping at every named stage to
+// read it back.
+#include <array>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "neuflow/model/session_settings.hpp"
+#include "neuflow/model/stage_observer.hpp"
+#include "tensor.hpp"
+#include "vulkan/device_weights.hpp"
+
+namespace neuflow::model::vulkan {
+
+// A channel range of a planar [C][H][W] tensor in a device buffer.
+struct View {
+  const Buffer* buffer = nullptr;
+  int channel = 0;  // first channel
+  int c = 0, h = 0, w = 0;
+  int offset() const { return channel * h * w; }  // in floats
+  int count() const { return c * h * w; }
+  View channels(int first, int n) const { return {buffer, channel + first, n, h, w}; }
+};
+
+class VulkanNetwork {
+ public:
+  static constexpr int kSlots = 3;  // frame features kept on the device (see InferenceBackend)
+
+  // height, width: multiples of 16, at least 32. Throws BackendError (e.g. out of memory).
+  VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width);
+  ~VulkanNetwork();
+  VulkanNetwork(const VulkanNetwork&) = delete;
+  VulkanNetwork& operator=(const VulkanNetwork&) = delete;
+
+  int height() const { return height_; }
+  int width() const { return width_; }
+
+  // image: [height, width, 3] NHWC in 0..1, as the CPU backend takes it.
+  void encode(const Tensor& image, int slot);
+  // out: [height, width, 2] NHWC.
+  void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer);
+
+  class Recorder;
+
+ private:
+  struct Slot {
+    Buffer f8, f16, up;
+  };
+  struct Refine {
+    Buffer input, constant_in, constant_out, xa, xb, out66;
+  };
+  void record_encode(Recorder& r, int slot);
+  void record_flow(Recorder& r, int slot0, int slot1, const Iterations& iterations);
+  void record_attention_layer(Recorder& r, const DeviceAttentionLayer& w, const Buffer& src, const Buffer& tgt,
+                              const Buffer& out);
+  void record_refinement(Recorder& r, const DeviceRefine& w, Refine& buffers, const View& f0, const View& f1,
+                         const View& flow, int iterations, const std::string& scale);
+  VkCommandBuffer cached(const std::string& key, int slot0, int slot1, const Iterations* iterations);
+  VkDescriptorSet descriptor_set(const std::array<VkBuffer, 4>& buffers);
+  void initialise_constants();
+
+  std::shared_ptr<const DeviceWeights> weights_;
+  VulkanDevice& device_;
+  int height_, width_, h8_, w8_, h16_, w16_, tokens_, block_rows_;
+
+  Buffer dummy_, upload_, readback_;
+  Buffer input_, half_, quarter_, eighth_, encode_tmp_, cat8_, cat16_;
+  std::array<Slot, kSlots> slots_;
+  Buffer q_, k_, v_, scores_, message_, attn_tmp_, mlp_in_, mlp_hidden_, state0_, state1_;
+  std::array<Buffer, 2> attended_;
+  Buffer grid_, correspondence_, flow16_, flow8_;
+  Refine refine16_, refine8_;
+  Buffer feature_in_, merge_tmp_, context_in_, context_tmp_;
+  std::array<Buffer, 2> features8_;
+  Buffer upsample_in_, upsample1_, upsample2_, mask_, flow_full_;
+
+  VkCommandPool pool_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  std::vector<VkDescriptorPool> descriptor_pools_;
+  std::map<std::array<VkBuffer, 4>, VkDescriptorSet> descriptor_sets_;
+  std::map<std::string, VkCommandBuffer> command_buffers_;
+  VkCommandBuffer observed_commands_ = VK_NULL_HANDLE;
+};
+
+}  // namespace neuflow::model::vulkan
