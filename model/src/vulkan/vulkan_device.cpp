@@ -17,6 +17,7 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     bytes_ = std::exchange(other.bytes_, 0);
     mapped_ = std::exchange(other.mapped_, nullptr);
+    counted_ = std::exchange(other.counted_, false);
   }
   return *this;
 }
@@ -198,7 +199,9 @@ Buffer VulkanDevice::create_buffer(std::size_t bytes, Memory memory, const std::
                            " MiB in one buffer, more than the device's maxStorageBufferRange (" +
                            std::to_string(info_.max_buffer_bytes >> 20) + " MiB): use a smaller model size");
   }
-  {
+  // The budget is on device memory; staging buffers are the host's.
+  const bool counted = memory == Memory::device;
+  if (counted) {
     const std::lock_guard lock(memory_mutex_);
     if (budget_ != 0 && allocated_ + bytes > budget_) {
       throw BackendError(BackendError::Kind::out_of_memory,
@@ -212,6 +215,7 @@ Buffer VulkanDevice::create_buffer(std::size_t bytes, Memory memory, const std::
   Buffer b;
   b.device_ = shared_from_this();
   b.bytes_ = bytes;
+  b.counted_ = counted;
   VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   info.size = bytes;
   info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
@@ -240,7 +244,7 @@ void VulkanDevice::release(Buffer& b) {
   if (b.mapped_) vkUnmapMemory(device_, b.memory_);
   if (b.buffer_ != VK_NULL_HANDLE) vkDestroyBuffer(device_, b.buffer_, nullptr);
   if (b.memory_ != VK_NULL_HANDLE) vkFreeMemory(device_, b.memory_, nullptr);
-  {
+  if (b.counted_) {
     const std::lock_guard lock(memory_mutex_);
     allocated_ -= std::min(allocated_, b.bytes_);
   }

@@ -38,6 +38,7 @@ class Buffer {
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   std::size_t bytes_ = 0;
   void* mapped_ = nullptr;
+  bool counted_ = false;  // against the device memory budget
 };
 
 class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
@@ -61,7 +62,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   float timestamp_period_ns() const { return timestamp_period_; }
 
   enum class Memory { device, upload, readback };
-  // `what` names the buffer in an out-of-memory error. Honours NEUFLOW_VULKAN_MEMORY_BUDGET_MB.
+  // `what` names the buffer in an out-of-memory error. Device memory is held within
+  // NEUFLOW_VULKAN_MEMORY_BUDGET_MB when that is set (to share a GPU, or to test running out).
   Buffer create_buffer(std::size_t bytes, Memory memory, const std::string& what);
 
   // Submits and waits on `fence` (the caller's, unsignalled; left unsignalled). Throws

@@ -1,0 +1,185 @@
+// The Vulkan backend as a user relies on it: the same flow and stages as the CPU at a size
+// that is not a multiple of 16 with other iteration counts, streaming equal to pairs, and
+// failures (a device that does not exist, device memory running out) that are errors naming
+// the device, after which a new session works; backend=auto falls back to the CPU with one
+// warning. Runs on lavapipe in CI, under the validation layer.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <map>
+
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/flow_session.hpp"
+#include "neuflow/model/gpu_devices.hpp"
+#include "support/fixtures.hpp"
+#include "support/vulkan.hpp"
+
+namespace neuflow::model {
+namespace {
+
+ImageView view_of(const cv::Mat& m) {
+  return ImageView{m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), ChannelOrder::bgr};
+}
+
+struct Errors {
+  double max = 0, mean = 0;
+};
+
+Errors compare(const float* a, const float* b, std::size_t n) {
+  Errors e;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = std::fabs(static_cast<double>(a[i]) - b[i]);
+    e.max = std::max(e.max, d);
+    e.mean += d;
+  }
+  e.mean /= static_cast<double>(std::max<std::size_t>(n, 1));
+  return e;
+}
+
+Errors compare(const flow::FlowField& a, const flow::FlowField& b) {
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  return compare(a.uv.data(), b.uv.data(), std::min(a.uv.size(), b.uv.size()));
+}
+
+class VulkanSession : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    NEUFLOW_REQUIRE_FIXTURE(checkpoint, "neuflow-v2-seed0/checkpoint.pth");
+    NEUFLOW_REQUIRE_FIXTURE(frames, "frames");
+    NEUFLOW_REQUIRE_VULKAN();
+    if (!model_) model_ = FlowModel::load(checkpoint);
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(frames)) {
+      if (e.path().extension() == ".jpg") files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());
+    ASSERT_GE(files.size(), 3u);
+    for (int i = 0; i < 3; ++i) {
+      cv::Mat full = cv::imread(files[i].string(), cv::IMREAD_COLOR), small;
+      cv::resize(full, small, cv::Size(200, 120), 0, 0, cv::INTER_AREA);  // → 208×128 padded
+      frames_.push_back(small);
+    }
+  }
+  void TearDown() override { NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES(); }
+
+  static std::shared_ptr<const FlowModel> model_;
+  std::vector<cv::Mat> frames_;
+};
+
+std::shared_ptr<const FlowModel> VulkanSession::model_;
+
+TEST_F(VulkanSession, EveryStageEqualsTheCpuAtAnOddSizeAndOtherIterations) {
+  const Iterations iterations{2, 3};
+  FlowSession cpu(model_, {.iterations = iterations, .threads = 2, .backend = Backend::cpu});
+  FlowSession gpu(model_, {.iterations = iterations, .threads = 2, .backend = Backend::vulkan});
+  EXPECT_EQ(cpu.backend_description(), "cpu");
+  EXPECT_NE(gpu.backend_description().find("vulkan device"), std::string::npos) << gpu.backend_description();
+  std::map<std::string, std::vector<float>> cpu_stages;
+  cpu.set_observer([&](const StageTensor& t) {
+    cpu_stages[t.name + "#" + std::to_string(t.frame)] =
+        std::vector<float>(t.data, t.data + static_cast<std::size_t>(t.height) * t.width * t.channels);
+  });
+  int compared = 0;
+  gpu.set_observer([&](const StageTensor& t) {
+    const auto it = cpu_stages.find(t.name + "#" + std::to_string(t.frame));
+    ASSERT_NE(it, cpu_stages.end()) << t.name;
+    const std::size_t n = static_cast<std::size_t>(t.height) * t.width * t.channels;
+    ASSERT_EQ(it->second.size(), n) << t.name;
+    double magnitude = 0;
+    for (float v : it->second) magnitude = std::max(magnitude, static_cast<double>(std::fabs(v)));
+    const Errors e = compare(t.data, it->second.data(), n);
+    if (t.name == "flow") {
+      EXPECT_LT(e.max, 1e-2) << t.name;
+      EXPECT_LT(e.mean, 1e-3) << t.name;
+    } else {
+      EXPECT_LT(e.max, 1e-3 * std::max(magnitude, 1.0)) << t.name << " frame " << t.frame << " (mean " << e.mean << ")";
+    }
+    ++compared;
+  });
+  const auto expected = cpu.compute(view_of(frames_[0]), view_of(frames_[1]));
+  const auto got = gpu.compute(view_of(frames_[0]), view_of(frames_[1]));
+  // 5 backbone + 2 attention + matching + 2 × (3 per s16 iteration) + 3 merges + 3 × 3 + flow
+  EXPECT_EQ(compared, 5 + 2 + 1 + 2 * 3 + 3 + 3 * 3 + 1);
+  const Errors e = compare(got, expected);
+  EXPECT_EQ(got.width, 200);
+  EXPECT_EQ(got.height, 120);
+  EXPECT_LT(e.max, 1e-2);
+  EXPECT_LT(e.mean, 1e-3);
+}
+
+TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {
+  FlowSession pairs(model_, {.iterations = {1, 2}, .backend = Backend::vulkan});
+  FlowSession stream(model_, {.iterations = {1, 2}, .backend = Backend::vulkan});
+  EXPECT_FALSE(stream.push(view_of(frames_[0])).has_value());
+  const auto s01 = stream.push(view_of(frames_[1]));
+  // A pair computed in between must not disturb the stream.
+  const auto p01 = stream.compute(view_of(frames_[0]), view_of(frames_[1]));
+  const auto s12 = stream.push(view_of(frames_[2]));
+  ASSERT_TRUE(s01 && s12);
+  const auto p12 = pairs.compute(view_of(frames_[1]), view_of(frames_[2]));
+  EXPECT_LT(compare(*s01, p01).max, 1e-5);
+  EXPECT_LT(compare(*s12, p12).max, 1e-5);
+  EXPECT_GT(compare(p01, p12).max, 1e-3) << "different pairs should give different flows";
+}
+
+TEST_F(VulkanSession, ADeviceThatDoesNotExistIsAnErrorNamingIt) {
+  try {
+    FlowSession session(model_, {.backend = Backend::vulkan, .device = 63});
+    FAIL() << "no error";
+  } catch (const BackendError& e) {
+    EXPECT_EQ(e.kind(), BackendError::Kind::unavailable);
+    EXPECT_NE(std::string(e.what()).find("no Vulkan device 63"), std::string::npos) << e.what();
+  }
+  // backend=auto with that device runs on the CPU.
+  FlowSession fallback(model_, {.iterations = {1, 1}, .backend = Backend::automatic, .device = 63});
+  EXPECT_EQ(fallback.backend_description(), "cpu");
+  EXPECT_EQ(fallback.compute(view_of(frames_[0]), view_of(frames_[1])).width, 200);
+}
+
+// Each gtest case runs as its own process under ctest, so the budget applies to this one only.
+TEST_F(VulkanSession, RunningOutOfDeviceMemoryIsAnErrorAndAutoFallsBackToTheCpu) {
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB", "38", 1), 0);  // the weights (35 MiB) fit, a 208×128 plan does not
+  {
+    FlowSession session(model_, {.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0});
+    try {
+      session.compute(view_of(frames_[0]), view_of(frames_[1]));
+      FAIL() << "no error";
+    } catch (const BackendError& e) {
+      EXPECT_EQ(e.kind(), BackendError::Kind::out_of_memory);
+      EXPECT_NE(std::string(e.what()).find("vulkan device 0"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("out of device memory"), std::string::npos) << e.what();
+    }
+    // The failed plan released what it had: a session at a size that fits works on the same device.
+    cv::Mat a, b;
+    cv::resize(frames_[0], a, cv::Size(64, 48));
+    cv::resize(frames_[1], b, cv::Size(64, 48));
+    FlowSession small(model_, {.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0});
+    EXPECT_EQ(small.compute(view_of(a), view_of(b)).width, 64);
+  }
+  FlowSession fallback(model_, {.iterations = {1, 1}, .backend = Backend::automatic, .device = 0});
+  const auto f = fallback.compute(view_of(frames_[0]), view_of(frames_[1]));
+  EXPECT_EQ(f.width, 200);
+  EXPECT_EQ(fallback.backend_description(), "cpu");
+  EXPECT_NE(fallback.fallback_warning().find("out of device memory"), std::string::npos) << fallback.fallback_warning();
+  unsetenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB");
+}
+
+TEST(VulkanDevices, EachDeviceHasANameTypeAndMemory) {
+  NEUFLOW_REQUIRE_VULKAN();
+  const auto devices = list_gpu_devices();
+  ASSERT_FALSE(devices.empty());
+  for (std::size_t i = 0; i < devices.size(); ++i) {
+    EXPECT_EQ(devices[i].index, static_cast<int>(i));
+    EXPECT_FALSE(devices[i].name.empty());
+    EXPECT_FALSE(devices[i].type.empty());
+    EXPECT_GT(devices[i].max_buffer_bytes, 0u);
+  }
+}
+
+}  // namespace
+}  // namespace neuflow::model
