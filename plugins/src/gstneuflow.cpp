@@ -63,6 +63,9 @@ enum {
   PROP_MODEL_HEIGHT,
   PROP_THREADS,
   PROP_CHANNEL_ORDER,
+  PROP_BACKEND,
+  PROP_DEVICE,
+  PROP_RUNNING_ON,
   PROP_BEHAVIOUR,
   PROP_STATS_INTERVAL,
   PROP_FRAMES_IN,
@@ -86,6 +89,7 @@ struct Settings {
   neuflow::model::SessionOptions session = DEFAULT_SESSION;
   Behaviour behaviour = Behaviour::automatic;
   guint stats_interval = DEFAULT_STATS_INTERVAL;
+  std::string running_on;  // read-only: the session's backend, once it exists
 };
 
 // One entry of the ordered stream between the streaming thread and the worker.
@@ -173,6 +177,18 @@ GType channel_order_get_type() {
       {static_cast<gint>(ChannelOrder::bgr), "BGR, as the reference demo scripts feed it", "bgr"},
       {0, nullptr, nullptr}};
   if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstNeuflowChannelOrder", values));
+  return type;
+}
+
+GType backend_get_type() {
+  using neuflow::model::Backend;
+  static GType type = 0;
+  static const GEnumValue values[] = {
+      {static_cast<gint>(Backend::automatic), "the first discrete or integrated GPU (Vulkan), else the CPU", "auto"},
+      {static_cast<gint>(Backend::cpu), "the CPU (oneDNN)", "cpu"},
+      {static_cast<gint>(Backend::vulkan), "a Vulkan device (see 'device'), software ones included", "vulkan"},
+      {0, nullptr, nullptr}};
+  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstNeuflowBackend", values));
   return type;
 }
 
@@ -586,10 +602,22 @@ GstStateChangeReturn change_state(GstElement *element, GstStateChange transition
       const Settings s = copy_settings(self);
       try {
         st.session = std::make_unique<FlowSession>(*self->model, s.session);
+      } catch (const neuflow::model::BackendError &e) {
+        GST_ELEMENT_ERROR(self, RESOURCE, FAILED, ("cannot run on the GPU: %s", e.what()),
+                          ("backend=%s device=%d; `neuflow devices` lists the Vulkan devices",
+                           std::string(neuflow::model::backend_name(s.session.backend)).c_str(), s.session.device));
+        return GST_STATE_CHANGE_FAILURE;
       } catch (const std::exception &e) {
         GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("invalid settings: %s", e.what()), (nullptr));
         return GST_STATE_CHANGE_FAILURE;
       }
+      if (!st.session->fallback_warning().empty()) {
+        GST_ELEMENT_WARNING(self, RESOURCE, FAILED, ("%s", st.session->fallback_warning().c_str()), (nullptr));
+      }
+      GST_INFO_OBJECT(self, "running on %s", st.session->backend_description().c_str());
+      GST_OBJECT_LOCK(self);
+      self->settings->running_on = st.session->backend_description();
+      GST_OBJECT_UNLOCK(self);
       const std::lock_guard lock(st.lock);
       st.stats.restart(std::chrono::steady_clock::now());
       st.next_frame = 0;
@@ -633,6 +661,8 @@ void set_property(GObject *object, guint id, const GValue *value, GParamSpec *ps
     case PROP_MODEL_HEIGHT: s.session.model_height = static_cast<int>(g_value_get_uint(value)); break;
     case PROP_THREADS: s.session.threads = static_cast<int>(g_value_get_uint(value)); break;
     case PROP_CHANNEL_ORDER: s.session.network_order = static_cast<ChannelOrder>(g_value_get_enum(value)); break;
+    case PROP_BACKEND: s.session.backend = static_cast<neuflow::model::Backend>(g_value_get_enum(value)); break;
+    case PROP_DEVICE: s.session.device = g_value_get_int(value); break;
     case PROP_BEHAVIOUR: s.behaviour = static_cast<Behaviour>(g_value_get_enum(value)); break;
     case PROP_STATS_INTERVAL: s.stats_interval = g_value_get_uint(value); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
@@ -669,6 +699,9 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
     case PROP_MODEL_HEIGHT: g_value_set_uint(value, static_cast<guint>(s.session.model_height)); break;
     case PROP_THREADS: g_value_set_uint(value, static_cast<guint>(s.session.threads)); break;
     case PROP_CHANNEL_ORDER: g_value_set_enum(value, static_cast<gint>(s.session.network_order)); break;
+    case PROP_BACKEND: g_value_set_enum(value, static_cast<gint>(s.session.backend)); break;
+    case PROP_DEVICE: g_value_set_int(value, s.session.device); break;
+    case PROP_RUNNING_ON: g_value_set_string(value, s.running_on.c_str()); break;
     case PROP_BEHAVIOUR: g_value_set_enum(value, static_cast<gint>(s.behaviour)); break;
     case PROP_STATS_INTERVAL: g_value_set_uint(value, s.stats_interval); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
@@ -734,6 +767,22 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
       g_param_spec_enum("channel-order", "Channel order", "Colour order fed to the network", channel_order_get_type(),
                         static_cast<gint>(DEFAULT_SESSION.network_order), rw));
   g_object_class_install_property(
+      gobject_class, PROP_BACKEND,
+      g_param_spec_enum("backend", "Backend",
+                        "Where the network runs: auto (the first discrete or integrated GPU through Vulkan, else the "
+                        "CPU, with a warning when a GPU fails), cpu, or vulkan (fails without a Vulkan device)",
+                        backend_get_type(), static_cast<gint>(DEFAULT_SESSION.backend), rw));
+  g_object_class_install_property(
+      gobject_class, PROP_DEVICE,
+      g_param_spec_int("device", "Device",
+                       "Vulkan device index as `neuflow devices` lists them; -1: the first discrete or integrated GPU",
+                       -1, SessionLimits::max_device, DEFAULT_SESSION.device, rw));
+  g_object_class_install_property(
+      gobject_class, PROP_RUNNING_ON,
+      g_param_spec_string("running-on", "Running on",
+                          "Where the network runs, once the element is PAUSED: 'cpu' or 'vulkan device N (name)'", "",
+                          ro));
+  g_object_class_install_property(
       gobject_class, PROP_BEHAVIOUR,
       g_param_spec_enum("behaviour", "Behaviour",
                         "live: hold real-time by dropping frames; every-pair: compute every consecutive pair",
@@ -779,6 +828,7 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
                                         "neuflow");
   gst_type_mark_as_plugin_api(channel_order_get_type(), static_cast<GstPluginAPIFlags>(0));
   gst_type_mark_as_plugin_api(behaviour_get_type(), static_cast<GstPluginAPIFlags>(0));
+  gst_type_mark_as_plugin_api(backend_get_type(), static_cast<GstPluginAPIFlags>(0));
   GST_DEBUG_CATEGORY_INIT(gst_neuflow_debug, "neuflow", 0, "NeuFlow-V2 optical flow element");
 }
 

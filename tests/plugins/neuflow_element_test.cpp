@@ -17,6 +17,9 @@
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "support/fixtures.hpp"
+#include "support/temp_dir.hpp"
+#include "support/vulkan.hpp"
+#include "neuflow/flow/flow_io.hpp"
 
 namespace {
 
@@ -386,6 +389,82 @@ TEST(NeuflowElementErrors, AMissingModelFailsTheStateChangeNamingTheFile) {
   GError* error = nullptr;
   gst_message_parse_error(msg, &error, nullptr);
   EXPECT_NE(std::string(error->message).find("/nonexistent/neuflow_mixed.pth"), std::string::npos) << error->message;
+  g_error_free(error);
+  gst_message_unref(msg);
+  gst_object_unref(bus);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
+// backend=vulkan: a file pipeline writes the same flows as the CPU session that `neuflow
+// flow`/`convert` run, and its element says where it runs. The plugin holds its own copy of the
+// core, so the validation layer is fatal there (any message aborts the test).
+TEST_F(NeuflowElement, VulkanBackendWritesTheSameFlowsAsTheCpu) {
+  NEUFLOW_REQUIRE_VULKAN();
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_VALIDATION", "fatal", 1), 0);
+  neuflow::test::TempDir dir("neuflow-vulkan-element");
+  std::vector<cv::Mat> frames;
+  for (int i = 0; i < 3; ++i) {
+    frames.push_back(synthetic_frame(64, 48, 3 * i));
+    cv::Mat bgr;
+    cv::cvtColor(frames.back(), bgr, cv::COLOR_RGB2BGR);
+    ASSERT_TRUE(cv::imwrite((dir / ("frame" + std::to_string(i) + ".png")).string(), bgr));
+  }
+  std::filesystem::create_directory(dir / "flow");
+  GError* err = nullptr;
+  GstElement* pipeline = gst_parse_launch(
+      ("multifilesrc location=" + (dir / "frame%d.png").string() +
+       " index=0 stop-index=2 caps=image/png,framerate=10/1 ! pngdec ! videoconvert ! neuflow name=nf backend=vulkan "
+       "device=0 iters-s8=2 behaviour=every-pair model=" + model_ + " ! neuflowsink location=" +
+       (dir / "flow" / "%05d.flo").string())
+          .c_str(),
+      &err);
+  ASSERT_EQ(err, nullptr) << err->message;
+  std::string error;
+  EXPECT_EQ(run_to_end(pipeline, 300 * GST_SECOND, &error), GST_MESSAGE_EOS) << error;
+  GstElement* nf = gst_bin_get_by_name(GST_BIN(pipeline), "nf");
+  gchar* running_on = nullptr;
+  g_object_get(nf, "running-on", &running_on, nullptr);
+  EXPECT_NE(std::string(running_on ? running_on : "").find("vulkan device 0"), std::string::npos) << running_on;
+  g_free(running_on);
+  gst_object_unref(nf);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+
+  neuflow::model::FlowSession cpu(neuflow::model::FlowModel::load(model_),
+                                  {.iterations = {1, 2}, .threads = 2, .backend = neuflow::model::Backend::cpu});
+  int compared = 0;
+  for (int i = 0; i < 3; ++i) {
+    const auto expected = cpu.push(neuflow::model::ImageView{frames[i].data, 64, 48, 64 * 3, neuflow::model::ChannelOrder::rgb});
+    if (!expected) continue;
+    char name[32];  // neuflowsink numbers the flows it writes from 0
+    std::snprintf(name, sizeof name, "%05d.flo", compared);
+    const auto got = neuflow::flow::read_flow(dir / "flow" / name);
+    ASSERT_EQ(got.uv.size(), expected->uv.size()) << name;
+    double max_err = 0;
+    for (std::size_t k = 0; k < got.uv.size(); ++k) max_err = std::max(max_err, static_cast<double>(std::fabs(got.uv[k] - expected->uv[k])));
+    EXPECT_LT(max_err, 1e-2) << name;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 2);
+  unsetenv("NEUFLOW_VULKAN_VALIDATION");
+}
+
+TEST(NeuflowElementErrors, AVulkanDeviceThatDoesNotExistFailsTheStateChangeNamingIt) {
+  NEUFLOW_REQUIRE_FIXTURE(path, "neuflow-v2-seed0/checkpoint.pth");
+  NEUFLOW_REQUIRE_VULKAN();
+  GError* err = nullptr;
+  GstElement* pipeline = gst_parse_launch(
+      ("videotestsrc num-buffers=2 ! neuflow backend=vulkan device=63 model=" + path.string() + " ! fakesink").c_str(),
+      &err);
+  ASSERT_EQ(err, nullptr);
+  EXPECT_EQ(gst_element_set_state(pipeline, GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
+  GstBus* bus = gst_element_get_bus(pipeline);
+  GstMessage* msg = gst_bus_timed_pop_filtered(bus, 5 * GST_SECOND, GST_MESSAGE_ERROR);
+  ASSERT_NE(msg, nullptr);
+  GError* error = nullptr;
+  gst_message_parse_error(msg, &error, nullptr);
+  EXPECT_NE(std::string(error->message).find("63"), std::string::npos) << error->message;
   g_error_free(error);
   gst_message_unref(msg);
   gst_object_unref(bus);

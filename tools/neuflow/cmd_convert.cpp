@@ -112,6 +112,7 @@ void run_convert(const ConvertArgs& a) {
     throw CommandError(exit_code_for(e), e.what());
   }
   model::FlowSession session(model, options);
+  announce_backend(session, "convert");
 
   ConvertSettings settings;
   settings.output_dir = a.output;

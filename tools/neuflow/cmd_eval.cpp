@@ -94,6 +94,7 @@ eval::FlowSource make_source(const EvalArgs& a) {
   const model::SessionOptions options = session_options(a.session);
   // FlowSource is copyable and FlowSession is not: share one predictor.
   auto predictor = std::make_shared<eval::ModelPredictor>(std::move(model), options);
+  announce_backend(predictor->session(), "eval");
   return [predictor](const eval::EvalSet& set, const eval::Pair& pair) { return (*predictor)(set, pair); };
 }
 

@@ -52,6 +52,7 @@ void run_flow(const FlowArgs& a) {
   }
   const auto model = load_model(a.model);
   model::FlowSession session(model, options);
+  announce_backend(session, "flow");
   const auto view = [](const cv::Mat& m) {  // OpenCV decodes to BGR
     return model::ImageView{m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), model::ChannelOrder::bgr};
   };

@@ -15,5 +15,6 @@ void register_flow(CLI::App& app);
 void register_convert(CLI::App& app);
 void register_eval(CLI::App& app);
 void register_fetch_model(CLI::App& app);
+void register_devices(CLI::App& app);
 
 }  // namespace neuflow::cli

@@ -6,10 +6,11 @@
 #include <string>
 
 #include "commands.hpp"
+#include "neuflow/model/gpu_devices.hpp"
 #include "common/usage_errors.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"neuflow: NeuFlow-V2 optical flow on the CPU"};
+  CLI::App app{"neuflow: NeuFlow-V2 optical flow on the CPU or a GPU (Vulkan)"};
   app.set_version_flag("--version", std::string("neuflow ") + NEUFLOW_VERSION);
   app.require_subcommand(1);
 
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
   neuflow::cli::register_convert(app);
   neuflow::cli::register_eval(app);
   neuflow::cli::register_fetch_model(app);
+  neuflow::cli::register_devices(app);
 
   if (argc <= 1) return neuflow::cli::report_no_arguments(app);
   try {
@@ -29,6 +31,9 @@ int main(int argc, char** argv) {
   } catch (const neuflow::cli::CommandError& e) {
     std::fprintf(stderr, "neuflow: %s\n", e.what());
     return e.exit_code;
+  } catch (const neuflow::model::BackendError& e) {
+    std::fprintf(stderr, "neuflow: %s\n", e.what());
+    return neuflow::cli::kExitUnavailable;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "neuflow: %s\n", e.what());
     return neuflow::cli::kExitFailure;

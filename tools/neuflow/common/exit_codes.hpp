@@ -18,6 +18,7 @@ inline constexpr int kExitFailure = 1;
 inline constexpr int kExitUsage = 64;       // EX_USAGE: the command line is wrong (CLI11's own codes are not used)
 inline constexpr int kExitDataError = 65;   // EX_DATAERR: an input file is malformed
 inline constexpr int kExitNoInput = 66;     // EX_NOINPUT: an input file is missing or unreadable
+inline constexpr int kExitUnavailable = 69;  // EX_UNAVAILABLE: the GPU backend (Vulkan, its device) failed
 inline constexpr int kExitCantCreate = 73;  // EX_CANTCREAT: an output could not be written
 
 // Thrown from a subcommand's callback: main prints "neuflow <sub>: <message>" and exits

@@ -39,6 +39,24 @@ void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions 
   command.add_option("--threads", o.threads, "CPU threads for inference (0: all cores)")
       ->capture_default_str()
       ->check(CLI::Range(0, L::max_threads));
+  command
+      .add_option("--backend", args.backend,
+                  "Where the network runs: auto (the first discrete or integrated GPU through Vulkan, else the "
+                  "CPU), cpu, or vulkan (any Vulkan device, software ones included)")
+      ->check(CLI::IsMember({"auto", "cpu", "vulkan"}))
+      ->capture_default_str();
+  command
+      .add_option("--device", o.device,
+                  "Vulkan device index, as `neuflow devices` lists them (-1: the first GPU)")
+      ->capture_default_str()
+      ->check(CLI::Range(-1, L::max_device));
+}
+
+void announce_backend(const model::FlowSession& session, const char* subcommand) {
+  if (!session.fallback_warning().empty()) {
+    std::fprintf(stderr, "neuflow %s: warning: %s\n", subcommand, session.fallback_warning().c_str());
+  }
+  std::fprintf(stderr, "neuflow %s: running on %s\n", subcommand, session.backend_description().c_str());
 }
 
 model::SessionOptions session_options(const SessionArgs& args) {
@@ -51,6 +69,7 @@ model::SessionOptions session_options(const SessionArgs& args) {
   }
   options.network_order = args.bgr_alias ? model::ChannelOrder::bgr
                                          : model::parse_channel_order(args.channel_order).value_or(model::ChannelOrder::rgb);
+  options.backend = model::parse_backend(args.backend).value_or(model::Backend::automatic);
   if (auto problem = model::check_session_options(options)) throw CommandError(kExitUsage, "--" + *problem);
   return options;
 }

@@ -8,6 +8,7 @@
 
 #include <string>
 
+#include "neuflow/model/flow_session.hpp"
 #include "neuflow/model/session_settings.hpp"
 
 namespace neuflow::cli {
@@ -17,6 +18,7 @@ struct SessionArgs {
   std::string channel_order{model::channel_order_name(model::SessionOptions{}.network_order)};
   std::string size_alias;  // --size WxH
   bool bgr_alias = false;  // --bgr
+  std::string backend{model::backend_name(model::SessionOptions{}.backend)};
 };
 
 enum class ModelSizeOptions { offered, not_offered };
@@ -27,5 +29,9 @@ void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions 
 // The parsed options, checked as the session checks them. Throws CommandError (kExitUsage)
 // naming the option and what it expected.
 model::SessionOptions session_options(const SessionArgs& args);
+
+// One line on stderr saying where the network runs ("neuflow flow: running on vulkan device 0
+// (...)"), and backend=auto's reason for not using a GPU it found, if any.
+void announce_backend(const model::FlowSession& session, const char* subcommand);
 
 }  // namespace neuflow::cli

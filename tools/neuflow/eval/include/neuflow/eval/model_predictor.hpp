@@ -31,6 +31,8 @@ class ModelPredictor {
   // The pair's images read from disk, then predict() with the set's padding.
   flow::FlowField operator()(const EvalSet& set, const Pair& pair);
 
+  const model::FlowSession& session() const { return session_; }
+
  private:
   model::FlowSession session_;
 };
