@@ -53,6 +53,8 @@ struct FlowConfig {
   int threads = 0;               // 0: an equal share of [daemon] threads
   std::string behaviour = "auto";      // auto | live | every-pair
   std::string channel_order = "rgb";   // rgb | bgr
+  std::string backend = "auto";        // auto | cpu | vulkan
+  int device = -1;                     // Vulkan device index; -1: the first GPU
   SourcePosition where;
   bool operator==(const FlowConfig&) const = default;
 };

@@ -14,6 +14,7 @@
 
 #include "neuflow/model/architecture.hpp"
 #include "neuflow/model/checkpoint.hpp"
+#include "neuflow/model/gpu_devices.hpp"
 
 namespace neuflow::daemon {
 namespace {
@@ -184,6 +185,31 @@ void check_elements(const std::vector<ElementNeed>& needs, const GstInventory& g
   }
 }
 
+// backend = "vulkan" waits (like a missing camera) until Vulkan and its device are there.
+void check_gpus(const std::vector<GpuNeed>& needs, Issues& issues) {
+  if (needs.empty()) return;
+  std::vector<model::GpuDevice> devices;
+  std::string unavailable;
+  try {
+    devices = model::list_gpu_devices();
+  } catch (const model::BackendError& e) {
+    unavailable = e.what();
+  }
+  for (const auto& need : needs) {
+    if (!unavailable.empty()) {
+      issues.add(need.where, "backend: " + need.user + " runs on Vulkan, but " + unavailable);
+    } else if (devices.empty()) {
+      issues.add(need.where, "backend: " + need.user +
+                                 " runs on Vulkan, but Vulkan has no device here (install the GPU's Vulkan driver; "
+                                 "`neuflow devices` lists what Vulkan sees)");
+    } else if (need.device >= static_cast<int>(devices.size())) {
+      issues.add(need.where, "device: " + need.user + " asks for Vulkan device " + std::to_string(need.device) +
+                                 ", but this machine has " + std::to_string(devices.size()) + " (0 to " +
+                                 std::to_string(devices.size() - 1) + "; `neuflow devices` lists them)");
+    }
+  }
+}
+
 void check_uri_schemes(const std::vector<UriSchemeNeed>& needs, const GstInventory& gstreamer, Issues& issues) {
   std::set<std::string> reported;
   for (const auto& need : needs) {
@@ -230,6 +256,7 @@ void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Iss
   }
   check_elements(needs.elements, gstreamer, issues);
   check_uri_schemes(needs.uri_schemes, gstreamer, issues);
+  check_gpus(needs.gpus, issues);
 }
 
 }  // namespace neuflow::daemon

@@ -42,8 +42,16 @@ struct UriSchemeNeed {
   SourcePosition where;
 };
 
+// backend = "vulkan": the device must exist (and Vulkan with it).
+struct GpuNeed {
+  int device = -1;   // -1: any
+  std::string user;  // "stream 'front'"
+  SourcePosition where;
+};
+
 struct MachineNeeds {
   std::vector<PathNeed> paths;
+  std::vector<GpuNeed> gpus;
   std::vector<ElementNeed> elements;
   std::vector<UriSchemeNeed> uri_schemes;
 };
@@ -89,7 +97,8 @@ struct ReadContext {
 // One [[stream]] (name, [stream.source], [stream.flow], [[stream.sink]]). `index` counts from 0.
 StreamConfig read_stream(const TableReader& stream, std::size_t index, ReadContext& context);
 SourceConfig read_source(const TableReader& source, const std::string& stream, ReadContext& context);
-FlowConfig read_flow(const TableReader& flow, ReadContext& context);
+// `stream` names the stream in messages.
+FlowConfig read_flow(const TableReader& flow, const std::string& stream, ReadContext& context);
 // Returns false when the sink could not be read well enough to keep (its type is unknown).
 bool read_sink(const TableReader& sink, std::size_t index, const std::string& stream, ReadContext& context,
                SinkConfig& out);

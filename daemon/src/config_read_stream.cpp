@@ -15,9 +15,11 @@ using SessionLimits = model::SessionLimits;
 
 }  // namespace
 
-FlowConfig read_flow(const TableReader& t, ReadContext& context) {
-  static constexpr std::array<std::string_view, 8> keys = {"model",        "iters-s16", "iters-s8",  "model-width",
-                                                           "model-height", "threads",   "behaviour", "channel-order"};
+FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContext& context) {
+  static constexpr std::array<std::string_view, 10> keys = {"model",        "iters-s16",     "iters-s8", "model-width",
+                                                            "model-height", "threads",       "behaviour",
+                                                            "channel-order", "backend",      "device"};
+  static constexpr std::array<std::string_view, 3> backends = {"auto", "cpu", "vulkan"};
   static constexpr std::array<std::string_view, 3> behaviours = {"auto", "live", "every-pair"};
   static constexpr std::array<std::string_view, 2> orders = {model::channel_order_name(model::ChannelOrder::rgb),
                                                              model::channel_order_name(model::ChannelOrder::bgr)};
@@ -55,6 +57,12 @@ FlowConfig read_flow(const TableReader& t, ReadContext& context) {
   if (auto v = t.integer("threads", 0, SessionLimits::max_threads)) f.threads = static_cast<int>(*v);
   if (auto v = t.choice("behaviour", behaviours)) f.behaviour = *v;
   if (auto v = t.choice("channel-order", orders)) f.channel_order = *v;
+  if (auto v = t.choice("backend", backends)) f.backend = *v;
+  if (auto v = t.integer("device", -1, SessionLimits::max_device)) f.device = static_cast<int>(*v);
+  if (f.backend == "vulkan") {
+    context.needs.gpus.push_back({f.device, "stream '" + stream + "'",
+                                  t.position(t.has("device") ? "device" : "backend")});
+  }
   return f;
 }
 
@@ -80,7 +88,7 @@ StreamConfig read_stream(const TableReader& t, std::size_t index, ReadContext& c
   }
   if (const auto* flow = t.table("flow", Need::required, "a [stream.flow] table with at least the model")) {
     const TableReader reader(*flow, "[stream.flow]", context.issues);
-    s.flow = read_flow(reader, context);
+    s.flow = read_flow(reader, label, context);
     context.need_elements(pipeline::required_elements(pipeline::FlowStage{}), "stream '" + label + "'", reader.where());
   }
   const auto* sinks = t.table_array("sink", Need::required,

@@ -100,6 +100,8 @@ ElementChain plan_flow(const FlowStage& flow) {
               .set("threads", std::to_string(s.threads))
               .set("behaviour", flow.behaviour)
               .set("channel-order", std::string(model::channel_order_name(s.network_order)))
+              .set("backend", std::string(model::backend_name(s.backend)))
+              .set("device", std::to_string(s.device))
               .set("stats-interval", "0")};  // the counters are read as properties
 }
 

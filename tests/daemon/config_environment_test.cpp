@@ -18,6 +18,7 @@
 #include "config_read.hpp"
 #include "checkpoint_builder.hpp"
 #include "config_test_util.hpp"
+#include "neuflow/model/gpu_devices.hpp"
 
 namespace neuflow::daemon {
 namespace {
@@ -312,6 +313,39 @@ sink = [ { type = "display" } ]
   EXPECT_TRUE(has_issue(issues, 5, 36, "does not exist: is the camera connected?"));
   EXPECT_TRUE(has_issue(issues, 6, 18, "model: \"" + (folder / "missing.pth").string() + "\""));
   EXPECT_TRUE(has_issue(issues, 6, 44, "iters-s8: expected an integer 0..64, got 100"));
+}
+
+// backend = "vulkan" needs Vulkan and the device; the issue points at the key. backend = "auto"
+// needs neither (it falls back to the CPU).
+TEST(ConfigMachine, AVulkanDeviceMustExist) {
+  TempFolder folder;
+  write_model(folder / "m.pth");
+  const fs::path file = folder / "neuflowd.toml";
+  const auto all = inventory_without({});
+  const auto with_flow = [&](const std::string& flow) {
+    return "[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"m.pth\", " + flow +
+           " }\nsink = [ { type = \"display\" } ]\n";
+  };
+  EXPECT_TRUE(machine_issues(with_flow("backend = \"auto\", device = 63"), all, file).empty());
+  EXPECT_TRUE(machine_issues(with_flow("backend = \"cpu\""), all, file).empty());
+  bool have_vulkan = false;
+  std::size_t devices = 0;
+  try {
+    devices = model::list_gpu_devices().size();
+    have_vulkan = devices > 0;
+  } catch (const model::BackendError&) {
+  }
+  const auto issues = machine_issues(with_flow("backend = \"vulkan\", device = 63"), all, file);
+  ASSERT_EQ(issues.size(), 1u) << test::listed(issues);
+  if (have_vulkan) {
+    EXPECT_TRUE(has_issue(issues, 4, 56,
+                          "device: stream 's' asks for Vulkan device 63, but this machine has " +
+                              std::to_string(devices)))
+        << test::listed(issues);
+    EXPECT_TRUE(machine_issues(with_flow("backend = \"vulkan\", device = 0"), all, file).empty());
+  } else {
+    EXPECT_TRUE(has_issue(issues, 4, 56, "backend: stream 's' runs on Vulkan, but")) << test::listed(issues);
+  }
 }
 
 }  // namespace

@@ -89,13 +89,13 @@ TEST(GraphPlan, FlowStageCarriesTheSessionSettings) {
   FlowStage flow;
   flow.model = "/m.pth";
   flow.session = {.iterations = {2, 6}, .model_width = 640, .model_height = 352, .threads = 3,
-                  .network_order = model::ChannelOrder::bgr};
+                  .network_order = model::ChannelOrder::bgr, .backend = model::Backend::vulkan, .device = 1};
   flow.behaviour = "live";
   const ElementChain chain = plan_flow(flow);
   ASSERT_EQ(chain.size(), 2u);
   EXPECT_EQ(launch_text({chain[1]}),
             "neuflow name=flow model=\"/m.pth\" iters-s16=2 iters-s8=6 model-width=640 model-height=352 threads=3 "
-            "behaviour=live channel-order=bgr stats-interval=0");
+            "behaviour=live channel-order=bgr backend=vulkan device=1 stats-interval=0");
 }
 
 TEST(GraphPlan, RtspMediaIsTheChannelEncodedAndPacketized) {

@@ -19,7 +19,5 @@ std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<Vulk
   unavailable();
 }
 int find_gpu_for_auto(int) { return -1; }
-std::vector<GpuDevice> list_gpu_devices() { unavailable(); }
-std::size_t vulkan_validation_message_count() { return 0; }
 
 }  // namespace neuflow::model
