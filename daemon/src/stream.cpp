@@ -350,7 +350,14 @@ void Stream::mark_playing() {
   enter(StreamState::playing);
   settled_ = true;
   last_progress_ = Clock::now();
-  log_info("stream " + config_.name + ": playing");
+  std::string where;
+  if (graph_) {
+    gchar* running_on = nullptr;
+    g_object_get(graph_->flow_element(), "running-on", &running_on, nullptr);
+    if (running_on && *running_on) where = std::string(" on ") + running_on;
+    g_free(running_on);
+  }
+  log_info("stream " + config_.name + ": playing" + where);
 }
 
 void Stream::read_counters() {
