@@ -38,11 +38,14 @@ struct Config {
   std::filesystem::path model;
   std::filesystem::path frames;
   int threads = 2;
+  bool vulkan = false;  // --backend vulkan: the Vulkan backend too, against the CPU in the same run
+  int device = -1;
   std::vector<std::pair<int, int>> sizes{{320, 256}, {512, 384}, {768, 432}, {1024, 448}};
 };
 
 Config g_config;
 double g_sgemm_peak_gflops = 0;
+std::map<std::string, double> g_cpu_ms;  // "pair/768x432" → the CPU's time in this run
 std::shared_ptr<const FlowModel> g_model;
 
 double peak_rss_mb() {
@@ -107,8 +110,23 @@ void report(benchmark::State& state, double seconds_per_item, double flops) {
   state.counters["peak_rss_MB"] = peak_rss_mb();
 }
 
-void BM_Pair(benchmark::State& state, int width, int height) {
-  FlowSession session(g_model, {.threads = g_config.threads});
+neuflow::model::SessionOptions options_for(neuflow::model::Backend backend) {
+  return {.threads = g_config.threads, .backend = backend, .device = g_config.device};
+}
+
+// On the Vulkan backend: the time against the CPU's for the same work, measured just before.
+void compare_to_cpu(benchmark::State& state, const std::string& key, neuflow::model::Backend backend) {
+  if (backend == neuflow::model::Backend::cpu) {
+    g_cpu_ms[key] = state.counters["ms"];
+  } else if (const auto it = g_cpu_ms.find(key); it != g_cpu_ms.end() && state.counters["ms"] > 0) {
+    state.counters["cpu_ms"] = it->second;
+    state.counters["x_cpu"] = it->second / state.counters["ms"];
+  }
+}
+
+void BM_Pair(benchmark::State& state, int width, int height, neuflow::model::Backend backend) {
+  FlowSession session(g_model, options_for(backend));
+  if (backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
   const auto frames = load_frames(width, height);
   session.compute(view(frames[0]), view(frames[1]));  // warm-up: primitives and buffers
   double total = 0;
@@ -121,10 +139,12 @@ void BM_Pair(benchmark::State& state, int width, int height) {
     ++i;
   }
   report(state, total / static_cast<double>(state.iterations()), neuflow::model::network_cost(height, width).pair());
+  compare_to_cpu(state, "pair/" + std::to_string(width) + "x" + std::to_string(height), backend);
 }
 
-void BM_Stream(benchmark::State& state, int width, int height) {
-  FlowSession session(g_model, {.threads = g_config.threads});
+void BM_Stream(benchmark::State& state, int width, int height, neuflow::model::Backend backend) {
+  FlowSession session(g_model, options_for(backend));
+  if (backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
   const auto frames = load_frames(width, height);
   session.push(view(frames[0]));
   session.push(view(frames[1]));  // warm-up
@@ -139,12 +159,13 @@ void BM_Stream(benchmark::State& state, int width, int height) {
   }
   report(state, total / static_cast<double>(state.iterations()),
          neuflow::model::network_cost(height, width).stream_frame());
+  compare_to_cpu(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), backend);
 }
 
 // Where a streamed frame's time goes: the observer is called at the end of each stage, so the
 // time between consecutive calls is the stage's (refinement iterations summed per scale).
 void BM_StreamStages(benchmark::State& state, int width, int height) {
-  FlowSession session(g_model, {.threads = g_config.threads});
+  FlowSession session(g_model, options_for(neuflow::model::Backend::cpu));
   const auto frames = load_frames(width, height);
   std::map<std::string, double> stage_seconds;
   auto last = std::chrono::steady_clock::now();
@@ -208,6 +229,15 @@ int main(int argc, char** argv) {
   if (take_option(argc, argv, "--model", value)) g_config.model = value;
   if (take_option(argc, argv, "--frames", value)) g_config.frames = value;
   if (take_option(argc, argv, "--threads", value)) g_config.threads = std::stoi(value);
+  if (take_option(argc, argv, "--backend", value)) {
+    if (value != "cpu" && value != "vulkan") {
+      std::fprintf(stderr, "neuflow-bench-core: --backend wants cpu or vulkan (vulkan also runs the CPU, to compare), got '%s'\n",
+                   value.c_str());
+      return 64;
+    }
+    g_config.vulkan = value == "vulkan";
+  }
+  if (take_option(argc, argv, "--device", value)) g_config.device = std::stoi(value);
   if (take_option(argc, argv, "--sizes", value)) {
     g_config.sizes.clear();
     for (std::size_t pos = 0; pos < value.size();) {
@@ -231,8 +261,22 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark("sgemm_peak/2048", BM_SgemmPeak)->Arg(2048)->Iterations(8)->Unit(benchmark::kMillisecond);
   for (const auto& [w, h] : g_config.sizes) {
     const std::string size = std::to_string(w) + "x" + std::to_string(h);
-    benchmark::RegisterBenchmark(("pair/" + size).c_str(), BM_Pair, w, h)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-    benchmark::RegisterBenchmark(("stream/" + size).c_str(), BM_Stream, w, h)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+    using neuflow::model::Backend;
+    benchmark::RegisterBenchmark(("pair/" + size).c_str(), BM_Pair, w, h, Backend::cpu)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(2.0);
+    benchmark::RegisterBenchmark(("stream/" + size).c_str(), BM_Stream, w, h, Backend::cpu)
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(2.0);
+    if (g_config.vulkan) {
+      // Lavapipe (Vulkan on the CPU) runs these too, but its times say nothing of a GPU's.
+      benchmark::RegisterBenchmark(("vulkan_pair/" + size).c_str(), BM_Pair, w, h, Backend::vulkan)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(2.0);
+      benchmark::RegisterBenchmark(("vulkan_stream/" + size).c_str(), BM_Stream, w, h, Backend::vulkan)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(2.0);
+    }
     benchmark::RegisterBenchmark(("stream_stages/" + size).c_str(), BM_StreamStages, w, h)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(3);

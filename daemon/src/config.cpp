@@ -120,6 +120,7 @@ pipeline::GraphDescription graph_description(const StreamConfig& stream, int thr
   graph.flow.session.network_order = model::parse_channel_order(f.channel_order).value_or(model::ChannelOrder::rgb);
   graph.flow.session.backend = model::parse_backend(f.backend).value_or(model::Backend::automatic);
   graph.flow.session.device = f.device;
+  graph.flow.session.precision = model::parse_precision(f.precision).value_or(model::Precision::fp32);
   graph.flow.behaviour = f.behaviour;
   for (const SinkConfig& sink : stream.sinks) graph.sinks.push_back({sink.name, sink.settings});
   return graph;

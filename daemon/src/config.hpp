@@ -55,6 +55,7 @@ struct FlowConfig {
   std::string channel_order = "rgb";   // rgb | bgr
   std::string backend = "auto";        // auto | cpu | vulkan
   int device = -1;                     // Vulkan device index; -1: the first GPU
+  std::string precision = "fp32";      // fp32 | fp16
   SourcePosition where;
   bool operator==(const FlowConfig&) const = default;
 };

@@ -46,11 +46,11 @@ FlowSession::FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions 
   if (auto problem = check_session_options(options_)) throw std::invalid_argument(*problem);
   auto& s = *state_;
   if (options_.backend == Backend::vulkan) {
-    s.vulkan = open_vulkan(model_, options_.device);
+    s.vulkan = open_vulkan(model_, options_.device, options_.precision, s.fallback);
   } else if (options_.backend == Backend::automatic) {
     if (const int gpu = find_gpu_for_auto(options_.device); gpu >= 0) {
       try {
-        s.vulkan = open_vulkan(model_, gpu);
+        s.vulkan = open_vulkan(model_, gpu, options_.precision, s.fallback);
       } catch (const BackendError& e) {
         s.fallback = std::string("backend auto: ") + e.what() + "; running on the CPU instead";
       }

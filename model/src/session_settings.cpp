@@ -76,6 +76,12 @@ std::optional<ChannelOrder> parse_channel_order(std::string_view name) {
 
 namespace neuflow::model {
 
+std::optional<Precision> parse_precision(std::string_view name) {
+  if (name == "fp32") return Precision::fp32;
+  if (name == "fp16") return Precision::fp16;
+  return std::nullopt;
+}
+
 std::optional<Backend> parse_backend(std::string_view name) {
   if (name == "auto") return Backend::automatic;
   if (name == "cpu") return Backend::cpu;

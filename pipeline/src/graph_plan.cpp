@@ -102,6 +102,7 @@ ElementChain plan_flow(const FlowStage& flow) {
               .set("channel-order", std::string(model::channel_order_name(s.network_order)))
               .set("backend", std::string(model::backend_name(s.backend)))
               .set("device", std::to_string(s.device))
+              .set("precision", std::string(model::precision_name(s.precision)))
               .set("stats-interval", "0")};  // the counters are read as properties
 }
 

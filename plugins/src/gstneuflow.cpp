@@ -65,6 +65,7 @@ enum {
   PROP_CHANNEL_ORDER,
   PROP_BACKEND,
   PROP_DEVICE,
+  PROP_PRECISION,
   PROP_RUNNING_ON,
   PROP_BEHAVIOUR,
   PROP_STATS_INTERVAL,
@@ -189,6 +190,18 @@ GType backend_get_type() {
       {static_cast<gint>(Backend::vulkan), "a Vulkan device (see 'device'), software ones included", "vulkan"},
       {0, nullptr, nullptr}};
   if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstNeuflowBackend", values));
+  return type;
+}
+
+GType precision_get_type() {
+  using neuflow::model::Precision;
+  static GType type = 0;
+  static const GEnumValue values[] = {
+      {static_cast<gint>(Precision::fp32), "32-bit floats: exact to the reference", "fp32"},
+      {static_cast<gint>(Precision::fp16), "16-bit storage on devices with shaderFloat16 (else fp32, with a warning)",
+       "fp16"},
+      {0, nullptr, nullptr}};
+  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static("GstNeuflowPrecision", values));
   return type;
 }
 
@@ -663,6 +676,7 @@ void set_property(GObject *object, guint id, const GValue *value, GParamSpec *ps
     case PROP_CHANNEL_ORDER: s.session.network_order = static_cast<ChannelOrder>(g_value_get_enum(value)); break;
     case PROP_BACKEND: s.session.backend = static_cast<neuflow::model::Backend>(g_value_get_enum(value)); break;
     case PROP_DEVICE: s.session.device = g_value_get_int(value); break;
+    case PROP_PRECISION: s.session.precision = static_cast<neuflow::model::Precision>(g_value_get_enum(value)); break;
     case PROP_BEHAVIOUR: s.behaviour = static_cast<Behaviour>(g_value_get_enum(value)); break;
     case PROP_STATS_INTERVAL: s.stats_interval = g_value_get_uint(value); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
@@ -701,6 +715,7 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
     case PROP_CHANNEL_ORDER: g_value_set_enum(value, static_cast<gint>(s.session.network_order)); break;
     case PROP_BACKEND: g_value_set_enum(value, static_cast<gint>(s.session.backend)); break;
     case PROP_DEVICE: g_value_set_int(value, s.session.device); break;
+    case PROP_PRECISION: g_value_set_enum(value, static_cast<gint>(s.session.precision)); break;
     case PROP_RUNNING_ON: g_value_set_string(value, s.running_on.c_str()); break;
     case PROP_BEHAVIOUR: g_value_set_enum(value, static_cast<gint>(s.behaviour)); break;
     case PROP_STATS_INTERVAL: g_value_set_uint(value, s.stats_interval); break;
@@ -778,6 +793,11 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
                        "Vulkan device index as `neuflow devices` lists them; -1: the first discrete or integrated GPU",
                        -1, SessionLimits::max_device, DEFAULT_SESSION.device, rw));
   g_object_class_install_property(
+      gobject_class, PROP_PRECISION,
+      g_param_spec_enum("precision", "Precision",
+                        "What a Vulkan device stores tensors in (the CPU computes in fp32 either way)",
+                        precision_get_type(), static_cast<gint>(DEFAULT_SESSION.precision), rw));
+  g_object_class_install_property(
       gobject_class, PROP_RUNNING_ON,
       g_param_spec_string("running-on", "Running on",
                           "Where the network runs, once the element is PAUSED: 'cpu' or 'vulkan device N (name)'", "",
@@ -829,6 +849,7 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
   gst_type_mark_as_plugin_api(channel_order_get_type(), static_cast<GstPluginAPIFlags>(0));
   gst_type_mark_as_plugin_api(behaviour_get_type(), static_cast<GstPluginAPIFlags>(0));
   gst_type_mark_as_plugin_api(backend_get_type(), static_cast<GstPluginAPIFlags>(0));
+  gst_type_mark_as_plugin_api(precision_get_type(), static_cast<GstPluginAPIFlags>(0));
   GST_DEBUG_CATEGORY_INIT(gst_neuflow_debug, "neuflow", 0, "NeuFlow-V2 optical flow element");
 }
 

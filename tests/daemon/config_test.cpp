@@ -132,7 +132,7 @@ sink = [ { type = "display" } ]
   EXPECT_EQ(std::get<V4l2Source>(front.source.settings),
             (V4l2Source{"/dev/video2", VideoMode{1280, 720, 30000, 1001}, true}));
   EXPECT_EQ(front.source.where.line, 18);
-  EXPECT_EQ(front.flow, (FlowConfig{"/var/lib/neuflow/neuflow_mixed.pth", 2, 6, 640, 352, 3, "live", "bgr", "cpu", 0, {}}));
+  EXPECT_EQ(front.flow, (FlowConfig{"/var/lib/neuflow/neuflow_mixed.pth", 2, 6, 640, 352, 3, "live", "bgr", "cpu", 0, "fp32", {}}));
   EXPECT_EQ(front.flow.where.line, 25);
   ASSERT_EQ(front.sinks.size(), 4u);
   EXPECT_EQ(front.sinks[0].name, "front-ring");
@@ -153,7 +153,7 @@ sink = [ { type = "display" } ]
   const StreamConfig& cam = c.streams[1];
   EXPECT_EQ(std::get<LibcameraSource>(cam.source.settings),
             (LibcameraSource{"/base/imx219@10", VideoMode{640, 480, 15, 1}}));
-  EXPECT_EQ(cam.flow, (FlowConfig{"/models/m.pth", 1, 8, 0, 0, 0, "auto", "rgb", "auto", -1, {}}));
+  EXPECT_EQ(cam.flow, (FlowConfig{"/models/m.pth", 1, 8, 0, 0, 0, "auto", "rgb", "auto", -1, "fp32", {}}));
   ASSERT_EQ(cam.sinks.size(), 2u);
   EXPECT_EQ(cam.sinks[0].name, "rec");
   VideoSink file;
@@ -181,7 +181,7 @@ TEST(Config, OmittedKeysTakeTheirDefaults) {
   EXPECT_FALSE(c.rtsp);
   ASSERT_EQ(c.streams.size(), 1u);
   EXPECT_EQ(std::get<TestSource>(c.streams[0].source.settings), TestSource{});
-  EXPECT_EQ(c.streams[0].flow, (FlowConfig{"/m.pth", 1, 8, 0, 0, 0, "auto", "rgb", "auto", -1, {}}));
+  EXPECT_EQ(c.streams[0].flow, (FlowConfig{"/m.pth", 1, 8, 0, 0, 0, "auto", "rgb", "auto", -1, "fp32", {}}));
   EXPECT_EQ(c.streams[0].sinks[0].name, "display-0");
   EXPECT_EQ(std::get<DisplaySink>(c.streams[0].sinks[0].settings), DisplaySink{});
 

@@ -182,7 +182,7 @@ def mp4_decodes(path):
     return out.stdout.count("chain")
 
 
-def stream_block(name, source, sinks, behaviour="live"):
+def stream_block(name, source, sinks, behaviour="live", flow=""):
     text = f"""
 [[stream]]
 name = "{name}"
@@ -194,7 +194,7 @@ name = "{name}"
   iters-s8 = 1
   threads = 1
   behaviour = "{behaviour}"
-"""
+{flow}"""
     for sink in sinks:
         text += "  [[stream.sink]]\n" + sink + "\n"
     return text
@@ -399,6 +399,33 @@ class DaemonVideoOut(DaemonTestCase):
 
 
 class DaemonFailures(DaemonTestCase):
+    def test_a_missing_gpu_restarts_its_stream_while_the_others_run(self):
+        # backend = "vulkan" on a device that does not exist: the element's start fails
+        # naming the device, the stream backs off and retries; a CPU stream and a stream on
+        # Vulkan device 0 (lavapipe in CI) go on.
+        if os.environ.get("NEUFLOW_REQUIRE_VULKAN", "0") in ("", "0") and shutil.which("vulkaninfo") is None:
+            self.skipTest("no Vulkan here (NEUFLOW_REQUIRE_VULKAN=1 makes this a failure)")
+        good = os.path.join(self.dir, "good")
+        lava = os.path.join(self.dir, "lava")
+        text = ('[daemon]\nrestart-delay-min = 0.5\nrestart-delay-max = 2.0\n' +
+                stream_block("gpu", test_source(), ['  type = "files"\n  directory = "%s"' % os.path.join(self.dir, "gpu")],
+                             flow='  backend = "vulkan"\n  device = 63\n') +
+                stream_block("lava", test_source(fps=2, width=32, height=32), [f'  type = "files"\n  directory = "{lava}"'],
+                             flow='  backend = "vulkan"\n  device = 0\n') +
+                stream_block("good", test_source(), [f'  type = "files"\n  directory = "{good}"'],
+                             flow='  backend = "cpu"\n'))
+        d = self.start(text)
+        d.wait_ready(60)
+        d.wait_log(r"no Vulkan device 63", timeout=60)
+        d.wait_log(r"stream gpu: .*restarting in(.*\n)+.*stream gpu: .*restarting in", timeout=60)
+        d.wait_log(r"stream good: playing on cpu", timeout=60)
+        d.wait_log(r"stream lava: playing on vulkan device 0", timeout=120)
+        deadline = time.monotonic() + 60
+        while (not flow_files(good) or not flow_files(lava)) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        self.assertTrue(flow_files(good), "the CPU stream stopped producing")
+        self.assertTrue(flow_files(lava), "the stream on Vulkan device 0 produced nothing")
+
     def test_failing_source_restarts_while_other_stream_runs(self):
         # Nothing listens on this port: the RTSP source fails at once, every time.
         probe = socket.socket()

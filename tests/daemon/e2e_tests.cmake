@@ -32,6 +32,7 @@ foreach(test_case
     DaemonVideoOut.test_rtsp_credentials_keep_out_who_is_not_listed
     DaemonFailures.test_failing_source_restarts_while_other_stream_runs
     DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
+    DaemonFailures.test_a_missing_gpu_restarts_its_stream_while_the_others_run
     CheckConfig.test_valid_config_passes
     CheckConfig.test_errors_name_line_and_exit_78
     CheckConfig.test_unknown_choice_offers_the_closest_value

@@ -169,6 +169,48 @@ TEST_F(VulkanSession, RunningOutOfDeviceMemoryIsAnErrorAndAutoFallsBackToTheCpu)
   unsetenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB");
 }
 
+// fp16 storage against fp32 on the same device, at two sizes. The bound (documented in
+// docs/benchmarks.md) is on the end-point error: mean under 0.5 % of the mean flow magnitude,
+// and no pixel off by more than 1 % of the largest vector (measured on lavapipe: 0.13-0.14 % and
+// 0.23-0.26 %). The random-weight fixture model gives
+// large flows (over 100 px), so the bound is relative.
+TEST_F(VulkanSession, Fp16StaysWithinItsBoundOfFp32) {
+  bool fp16 = false;
+  for (const auto& d : list_gpu_devices()) fp16 = fp16 || (d.index == 0 && d.fp16);
+  if (!fp16) GTEST_SKIP() << "Vulkan device 0 has no fp16";
+  FlowSession fp32_session(model_, {.iterations = {1, 4}, .backend = Backend::vulkan, .device = 0});
+  FlowSession fp16_session(model_, {.iterations = {1, 4}, .backend = Backend::vulkan, .device = 0,
+                                    .precision = Precision::fp16});
+  EXPECT_NE(fp16_session.backend_description().find("fp16"), std::string::npos) << fp16_session.backend_description();
+  EXPECT_TRUE(fp16_session.fallback_warning().empty()) << fp16_session.fallback_warning();
+  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{128, 96}, {200, 120}}) {
+    cv::Mat a, b;
+    cv::resize(frames_[0], a, cv::Size(w, h));
+    cv::resize(frames_[1], b, cv::Size(w, h));
+    const auto exact = fp32_session.compute(view_of(a), view_of(b));
+    const auto half = fp16_session.compute(view_of(a), view_of(b));
+    double epe = 0, worst = 0, magnitude = 0, largest = 0;
+    const std::size_t n = exact.pixel_count();
+    for (std::size_t p = 0; p < n; ++p) {
+      const double du = half.uv[2 * p] - exact.uv[2 * p], dv = half.uv[2 * p + 1] - exact.uv[2 * p + 1];
+      const double e = std::sqrt(du * du + dv * dv);
+      const double m = std::hypot(static_cast<double>(exact.uv[2 * p]), static_cast<double>(exact.uv[2 * p + 1]));
+      epe += e;
+      magnitude += m;
+      worst = std::max(worst, e);
+      largest = std::max(largest, m);
+    }
+    epe /= static_cast<double>(n);
+    magnitude /= static_cast<double>(n);
+    std::printf("fp16 vs fp32 at %dx%d: mean EPE %.4f px (%.3f %% of the mean |flow| %.2f px), max %.4f px "
+                "(%.3f %% of the largest |flow| %.2f px)\n",
+                w, h, epe, 100 * epe / magnitude, magnitude, worst, 100 * worst / largest, largest);
+    RecordProperty("fp16_mean_epe_" + std::to_string(w) + "x" + std::to_string(h), std::to_string(epe));
+    EXPECT_LT(epe, 0.005 * magnitude) << w << "x" << h;
+    EXPECT_LT(worst, 0.01 * largest) << w << "x" << h;
+  }
+}
+
 TEST(VulkanDevices, EachDeviceHasANameTypeAndMemory) {
   NEUFLOW_REQUIRE_VULKAN();
   const auto devices = list_gpu_devices();

@@ -3,8 +3,10 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <tuple>
 #include <vector>
 
+#include "vulkan/half_float.hpp"
 #include "vulkan/one_shot_commands.hpp"
 
 namespace neuflow::model::vulkan {
@@ -53,11 +55,12 @@ class Packer {
 };
 
 std::shared_ptr<const DeviceWeights> upload(const std::shared_ptr<const FlowModel>& model,
-                                            const std::shared_ptr<VulkanDevice>& device) {
+                                            const std::shared_ptr<VulkanDevice>& device, bool fp16) {
   const NetworkWeights& w = model->weights();
   auto d = std::make_shared<DeviceWeights>();
   d->model = model;
   d->device = device;
+  d->fp16 = fp16;
   Packer p;
   d->block_8_1 = p.block(w.block_8_1);
   d->block_8_2 = p.block(w.block_8_2);
@@ -90,10 +93,15 @@ std::shared_ptr<const DeviceWeights> upload(const std::shared_ptr<const FlowMode
   d->upsample_conv2 = p.conv(w.upsample_conv2);
   d->upsample_conv3 = p.conv(w.upsample_conv3);
 
-  const std::size_t bytes = p.data.size() * sizeof(float);
+  const std::size_t bytes = p.data.size() * (fp16 ? 2 : 4);
   d->buffer = device->create_buffer(bytes, VulkanDevice::Memory::device, "the model's weights");
   Buffer staging = device->create_buffer(bytes, VulkanDevice::Memory::upload, "uploading the model's weights");
-  std::memcpy(staging.mapped(), p.data.data(), bytes);
+  if (fp16) {
+    auto* out = static_cast<std::uint16_t*>(static_cast<void*>(staging.mapped()));
+    for (std::size_t i = 0; i < p.data.size(); ++i) out[i] = to_half(p.data[i]);
+  } else {
+    std::memcpy(staging.mapped(), p.data.data(), bytes);
+  }
   OneShotCommands commands(*device);
   const VkBufferCopy region{0, 0, bytes};
   vkCmdCopyBuffer(commands.buffer(), staging.handle(), d->buffer.handle(), 1, &region);
@@ -104,13 +112,13 @@ std::shared_ptr<const DeviceWeights> upload(const std::shared_ptr<const FlowMode
 }  // namespace
 
 std::shared_ptr<const DeviceWeights> DeviceWeights::get(const std::shared_ptr<const FlowModel>& model,
-                                                        const std::shared_ptr<VulkanDevice>& device) {
+                                                        const std::shared_ptr<VulkanDevice>& device, bool fp16) {
   static std::mutex mutex;
-  static std::map<std::pair<const FlowModel*, const VulkanDevice*>, std::weak_ptr<const DeviceWeights>> uploaded;
+  static std::map<std::tuple<const FlowModel*, const VulkanDevice*, bool>, std::weak_ptr<const DeviceWeights>> uploaded;
   const std::lock_guard lock(mutex);
-  auto& slot = uploaded[{model.get(), device.get()}];
+  auto& slot = uploaded[{model.get(), device.get(), fp16}];
   if (auto existing = slot.lock()) return existing;
-  auto weights = upload(model, device);
+  auto weights = upload(model, device, fp16);
   slot = weights;
   return weights;
 }

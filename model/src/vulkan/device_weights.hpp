@@ -44,6 +44,7 @@ struct DeviceRefine {
 struct DeviceWeights {
   std::shared_ptr<const FlowModel> model;  // keeps the key of the sharing registry unique
   std::shared_ptr<VulkanDevice> device;
+  bool fp16 = false;  // stored as float16_t (offsets count elements either way)
   Buffer buffer;
   DeviceBlock block_8_1, block_8_2, block_cat_8, block_16_1, block_8_16, block_cat_16, conv_s8;
   std::array<DeviceAttentionLayer, 2> attention;
@@ -52,9 +53,9 @@ struct DeviceWeights {
   DeviceRefine refine_s16, refine_s8;
   DeviceConv upsample_conv1, upsample_conv2, upsample_conv3;
 
-  // The weights of `model` on `device`, uploaded on first use.
+  // The weights of `model` on `device` in that precision, uploaded on first use.
   static std::shared_ptr<const DeviceWeights> get(const std::shared_ptr<const FlowModel>& model,
-                                                  const std::shared_ptr<VulkanDevice>& device);
+                                                  const std::shared_ptr<VulkanDevice>& device, bool fp16);
 };
 
 }  // namespace neuflow::model::vulkan

@@ -38,21 +38,54 @@ constexpr std::uint32_t kRefineUpdate[] =
 constexpr std::uint32_t kConvexUpsample[] =
 #include "convex_upsample.spv.inc"
     ;
+constexpr std::uint32_t kConv2dFp16[] =
+#include "conv2d_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kMatmulFp16[] =
+#include "matmul_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kAvgpool2xFp16[] =
+#include "avgpool2x_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kResampleFp16[] =
+#include "resample_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kAxpbyFp16[] =
+#include "axpby_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kChannelAffineFp16[] =
+#include "channel_affine_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kSoftmaxRowsFp16[] =
+#include "softmax_rows_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kLayerNormFp16[] =
+#include "layer_norm_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kLocalCorrelationFp16[] =
+#include "local_correlation_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kRefineUpdateFp16[] =
+#include "refine_update_fp16.spv.inc"
+    ;
+constexpr std::uint32_t kConvexUpsampleFp16[] =
+#include "convex_upsample_fp16.spv.inc"
+    ;
 }  // namespace
 
-std::span<const std::uint32_t> spirv(Shader shader) {
+std::span<const std::uint32_t> spirv(Shader shader, bool fp16) {
   switch (shader) {
-    case Shader::conv2d: return kConv2d;
-    case Shader::matmul: return kMatmul;
-    case Shader::avgpool2x: return kAvgpool2x;
-    case Shader::resample: return kResample;
-    case Shader::axpby: return kAxpby;
-    case Shader::channel_affine: return kChannelAffine;
-    case Shader::softmax_rows: return kSoftmaxRows;
-    case Shader::layer_norm: return kLayerNorm;
-    case Shader::local_correlation: return kLocalCorrelation;
-    case Shader::refine_update: return kRefineUpdate;
-    case Shader::convex_upsample: return kConvexUpsample;
+    case Shader::conv2d: return fp16 ? std::span<const std::uint32_t>(kConv2dFp16) : std::span<const std::uint32_t>(kConv2d);
+    case Shader::matmul: return fp16 ? std::span<const std::uint32_t>(kMatmulFp16) : std::span<const std::uint32_t>(kMatmul);
+    case Shader::avgpool2x: return fp16 ? std::span<const std::uint32_t>(kAvgpool2xFp16) : std::span<const std::uint32_t>(kAvgpool2x);
+    case Shader::resample: return fp16 ? std::span<const std::uint32_t>(kResampleFp16) : std::span<const std::uint32_t>(kResample);
+    case Shader::axpby: return fp16 ? std::span<const std::uint32_t>(kAxpbyFp16) : std::span<const std::uint32_t>(kAxpby);
+    case Shader::channel_affine: return fp16 ? std::span<const std::uint32_t>(kChannelAffineFp16) : std::span<const std::uint32_t>(kChannelAffine);
+    case Shader::softmax_rows: return fp16 ? std::span<const std::uint32_t>(kSoftmaxRowsFp16) : std::span<const std::uint32_t>(kSoftmaxRows);
+    case Shader::layer_norm: return fp16 ? std::span<const std::uint32_t>(kLayerNormFp16) : std::span<const std::uint32_t>(kLayerNorm);
+    case Shader::local_correlation: return fp16 ? std::span<const std::uint32_t>(kLocalCorrelationFp16) : std::span<const std::uint32_t>(kLocalCorrelation);
+    case Shader::refine_update: return fp16 ? std::span<const std::uint32_t>(kRefineUpdateFp16) : std::span<const std::uint32_t>(kRefineUpdate);
+    case Shader::convex_upsample: return fp16 ? std::span<const std::uint32_t>(kConvexUpsampleFp16) : std::span<const std::uint32_t>(kConvexUpsample);
   }
   return {};
 }

@@ -21,7 +21,8 @@ enum class Shader {
 };
 inline constexpr std::size_t kShaderCount = 11;
 
-std::span<const std::uint32_t> spirv(Shader shader);
+// fp16: the variant that stores tensors as float16_t (precision.glsl).
+std::span<const std::uint32_t> spirv(Shader shader, bool fp16);
 const char* shader_name(Shader shader);
 
 }  // namespace neuflow::model::vulkan

@@ -30,14 +30,23 @@ class VulkanBackend final : public InferenceBackend {
 
 }  // namespace
 
-std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>& model, int index) {
+std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>& model, int index,
+                                           Precision precision, std::string& note) {
   auto device = vulkan::VulkanDevice::open(index);
+  bool fp16 = precision == Precision::fp16;
+  if (fp16 && !device->info().fp16) {
+    note = "precision fp16: " + device->label() +
+           " has no shaderFloat16 and 16-bit storage (Vulkan 1.2); running in fp32 instead";
+    fp16 = false;
+  }
   auto context = std::make_shared<VulkanContext>();
-  context->weights = vulkan::DeviceWeights::get(model, device);
+  context->weights = vulkan::DeviceWeights::get(model, device, fp16);
   return context;
 }
 
-std::string describe(const VulkanContext& context) { return context.weights->device->label(); }
+std::string describe(const VulkanContext& context) {
+  return context.weights->device->label() + (context.weights->fp16 ? ", fp16" : "");
+}
 
 std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<VulkanContext>& context, int height,
                                                       int width) {

@@ -11,9 +11,11 @@ namespace neuflow::model {
 
 struct VulkanContext;
 
-// index -1: the first discrete or integrated GPU, else the first device. Throws BackendError.
-std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>& model, int index);
-// "vulkan device 0 (NVIDIA H200)".
+// index -1: the first discrete or integrated GPU, else the first device. fp16 on a device
+// without it opens fp32 and says so in `note`. Throws BackendError.
+std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>& model, int index,
+                                           Precision precision, std::string& note);
+// "vulkan device 0 (NVIDIA H200)", with ", fp16" when it stores fp16.
 std::string describe(const VulkanContext& context);
 // Throws BackendError (out of memory, ...).
 std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<VulkanContext>& context, int height,

@@ -95,6 +95,14 @@ VulkanDevice::VulkanDevice(VkPhysicalDevice physical, int index)
   queue.queueCount = 1;
   queue.pQueuePriorities = &priority;
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  VkPhysicalDeviceShaderFloat16Int8Features f16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_FLOAT16_INT8_FEATURES};
+  VkPhysicalDevice16BitStorageFeatures storage16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_16BIT_STORAGE_FEATURES};
+  if (info_.fp16) {  // the fp16 shader variants need both
+    f16.shaderFloat16 = VK_TRUE;
+    storage16.storageBuffer16BitAccess = VK_TRUE;
+    storage16.pNext = &f16;
+    info.pNext = &storage16;
+  }
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
   check(vkCreateDevice(physical_, &info, nullptr, &device_), "vkCreateDevice");
@@ -127,28 +135,39 @@ void VulkanDevice::create_pipelines() {
   layout.pPushConstantRanges = &push;
   check(vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
 
-  for (std::size_t s = 0; s < kShaderCount; ++s) {
-    const auto shader = static_cast<Shader>(s);
-    const auto code = spirv(shader);
-    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    module_info.codeSize = code.size_bytes();
-    module_info.pCode = code.data();
-    VkShaderModule module = VK_NULL_HANDLE;
-    check(vkCreateShaderModule(device_, &module_info, nullptr, &module),
-          std::string("vkCreateShaderModule(") + shader_name(shader) + ")");
-    VkComputePipelineCreateInfo pipeline{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    pipeline.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    pipeline.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeline.stage.module = module;
-    pipeline.stage.pName = "main";
-    pipeline.layout = pipeline_layout_;
-    const VkResult r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline, nullptr, &pipelines_[s]);
-    vkDestroyShaderModule(device_, module, nullptr);
-    if (r != VK_SUCCESS) {
-      throw BackendError(BackendError::Kind::driver, label_ + ": the driver rejected the compute pipeline '" +
-                                                         shader_name(shader) + "': " + result_text(r));
-    }
+  for (std::size_t s = 0; s < kShaderCount; ++s) pipelines_[s] = create_pipeline(static_cast<Shader>(s), false);
+}
+
+VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16) {
+  const auto code = spirv(shader, fp16);
+  const std::string name = std::string(shader_name(shader)) + (fp16 ? " (fp16)" : "");
+  VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  module_info.codeSize = code.size_bytes();
+  module_info.pCode = code.data();
+  VkShaderModule module = VK_NULL_HANDLE;
+  check(vkCreateShaderModule(device_, &module_info, nullptr, &module), "vkCreateShaderModule(" + name + ")");
+  VkComputePipelineCreateInfo pipeline{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  pipeline.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  pipeline.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  pipeline.stage.module = module;
+  pipeline.stage.pName = "main";
+  pipeline.layout = pipeline_layout_;
+  VkPipeline created = VK_NULL_HANDLE;
+  const VkResult r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline, nullptr, &created);
+  vkDestroyShaderModule(device_, module, nullptr);
+  if (r != VK_SUCCESS) {
+    throw BackendError(BackendError::Kind::driver,
+                       label_ + ": the driver rejected the compute pipeline '" + name + "': " + result_text(r));
   }
+  return created;
+}
+
+VkPipeline VulkanDevice::pipeline(Shader shader, bool fp16) {
+  const auto s = static_cast<std::size_t>(shader);
+  if (!fp16) return pipelines_[s];
+  const std::lock_guard lock(pipeline_mutex_);
+  if (fp16_pipelines_[s] == VK_NULL_HANDLE) fp16_pipelines_[s] = create_pipeline(shader, true);
+  return fp16_pipelines_[s];
 }
 
 VulkanDevice::~VulkanDevice() { destroy(); }
@@ -156,9 +175,11 @@ VulkanDevice::~VulkanDevice() { destroy(); }
 void VulkanDevice::destroy() {
   if (device_ == VK_NULL_HANDLE) return;
   vkDeviceWaitIdle(device_);
-  for (VkPipeline& p : pipelines_) {
-    if (p != VK_NULL_HANDLE) vkDestroyPipeline(device_, p, nullptr);
-    p = VK_NULL_HANDLE;
+  for (auto* set : {&pipelines_, &fp16_pipelines_}) {
+    for (VkPipeline& p : *set) {
+      if (p != VK_NULL_HANDLE) vkDestroyPipeline(device_, p, nullptr);
+      p = VK_NULL_HANDLE;
+    }
   }
   if (pipeline_layout_ != VK_NULL_HANDLE) vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
   if (set_layout_ != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
@@ -192,7 +213,7 @@ uint32_t VulkanDevice::memory_type(uint32_t allowed, Memory memory) const {
 }
 
 Buffer VulkanDevice::create_buffer(std::size_t bytes, Memory memory, const std::string& what) {
-  bytes = std::max<std::size_t>(bytes, 16);
+  bytes = (std::max<std::size_t>(bytes, 16) + 15) / 16 * 16;  // whole 32-bit words for every view of it
   if (bytes > info_.max_buffer_bytes) {
     throw BackendError(BackendError::Kind::out_of_memory,
                        label_ + ": " + what + " needs " + std::to_string(bytes >> 20) +

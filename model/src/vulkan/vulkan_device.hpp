@@ -56,7 +56,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   const std::string& label() const { return label_; }
   VkDevice handle() const { return device_; }
   uint32_t queue_family() const { return queue_family_; }
-  VkPipeline pipeline(Shader shader) const { return pipelines_[static_cast<std::size_t>(shader)]; }
+  // The fp16 variants are created on first use (info().fp16 devices only).
+  VkPipeline pipeline(Shader shader, bool fp16);
   VkPipelineLayout pipeline_layout() const { return pipeline_layout_; }
   VkDescriptorSetLayout set_layout() const { return set_layout_; }
   float timestamp_period_ns() const { return timestamp_period_; }
@@ -82,6 +83,7 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   friend class Buffer;
   VulkanDevice(VkPhysicalDevice physical, int index);
   void create_pipelines();
+  VkPipeline create_pipeline(Shader shader, bool fp16);
   void destroy();
   uint32_t memory_type(uint32_t allowed, Memory memory) const;
   void release(Buffer& buffer);
@@ -97,6 +99,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
   std::array<VkPipeline, kShaderCount> pipelines_{};
+  std::array<VkPipeline, kShaderCount> fp16_pipelines_{};
+  std::mutex pipeline_mutex_;
   std::mutex queue_mutex_;
   std::mutex memory_mutex_;
   std::size_t allocated_ = 0;

@@ -57,7 +57,8 @@ Instance create_instance() {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "neuflow";
   app.pEngineName = "neuflow";
-  app.apiVersion = VK_API_VERSION_1_1;
+  // 1.2 where the loader has it: the fp16 features are core there.
+  app.apiVersion = volkGetInstanceVersion() >= VK_API_VERSION_1_2 ? VK_API_VERSION_1_2 : VK_API_VERSION_1_1;
   VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
   info.pApplicationInfo = &app;
   const char* layer = "VK_LAYER_KHRONOS_validation";
@@ -130,9 +131,11 @@ GpuDevice describe(VkPhysicalDevice device, int index) {
   vkGetPhysicalDeviceProperties(device, &props);
   VkPhysicalDeviceMemoryProperties memory;
   vkGetPhysicalDeviceMemoryProperties(device, &memory);
+  // shaderFloat16 is core in Vulkan 1.2; on older devices (and loaders) fp16 is not offered.
   VkPhysicalDeviceShaderFloat16Int8Features f16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_FLOAT16_INT8_FEATURES};
   VkPhysicalDevice16BitStorageFeatures storage16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_16BIT_STORAGE_FEATURES};
-  storage16.pNext = &f16;
+  const bool vulkan12 = props.apiVersion >= VK_API_VERSION_1_2 && volkGetInstanceVersion() >= VK_API_VERSION_1_2;
+  if (vulkan12) storage16.pNext = &f16;
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   features.pNext = &storage16;
   vkGetPhysicalDeviceFeatures2(device, &features);
@@ -153,7 +156,7 @@ GpuDevice describe(VkPhysicalDevice device, int index) {
     if (memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) d.memory_bytes += memory.memoryHeaps[h].size;
   }
   d.max_buffer_bytes = props.limits.maxStorageBufferRange;
-  d.fp16 = f16.shaderFloat16 && storage16.storageBuffer16BitAccess;
+  d.fp16 = vulkan12 && f16.shaderFloat16 && storage16.storageBuffer16BitAccess;
   return d;
 }
 

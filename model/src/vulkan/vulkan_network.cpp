@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "vulkan/half_float.hpp"
 #include "vulkan/one_shot_commands.hpp"
 
 namespace neuflow::model::vulkan {
@@ -76,7 +77,7 @@ class VulkanNetwork::Recorder {
       handles[i] = (bindings[i] ? *bindings[i] : net_.dummy_).handle();
     }
     VkDescriptorSet set = net_.descriptor_set(handles);
-    vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader));
+    vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader, net_.fp16_));
     vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline_layout(), 0, 1, &set, 0,
                             nullptr);
     vkCmdPushConstants(commands_, net_.device_.pipeline_layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
@@ -86,21 +87,23 @@ class VulkanNetwork::Recorder {
 
   void copy(const View& src, const View& dst) {
     barrier();
-    const VkBufferCopy region{static_cast<VkDeviceSize>(src.offset()) * 4, static_cast<VkDeviceSize>(dst.offset()) * 4,
-                              static_cast<VkDeviceSize>(src.count()) * 4};
+    const VkDeviceSize e = net_.elem_;
+    const VkBufferCopy region{static_cast<VkDeviceSize>(src.offset()) * e, static_cast<VkDeviceSize>(dst.offset()) * e,
+                              static_cast<VkDeviceSize>(src.count()) * e};
     vkCmdCopyBuffer(commands_, src.buffer->handle(), dst.buffer->handle(), 1, &region);
   }
-  void copy_raw(const Buffer& src, const Buffer& dst, std::size_t floats, std::size_t dst_offset = 0) {
+  void copy_raw(const Buffer& src, const Buffer& dst, std::size_t values) {
     barrier();
-    const VkBufferCopy region{0, dst_offset * 4, floats * 4};
+    const VkBufferCopy region{0, 0, values * net_.elem_};
     vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), 1, &region);
   }
-  void fill(const View& dst, float value) {
+  // A copy of the zero buffer: vkCmdFillBuffer needs 4-byte alignment, which 16-bit values
+  // at an odd offset do not have.
+  void zero(const View& dst) {
     barrier();
-    uint32_t bits;
-    std::memcpy(&bits, &value, 4);
-    vkCmdFillBuffer(commands_, dst.buffer->handle(), static_cast<VkDeviceSize>(dst.offset()) * 4,
-                    static_cast<VkDeviceSize>(dst.count()) * 4, bits);
+    const VkBufferCopy region{0, static_cast<VkDeviceSize>(dst.offset()) * net_.elem_,
+                              static_cast<VkDeviceSize>(dst.count()) * net_.elem_};
+    vkCmdCopyBuffer(commands_, net_.zeros_.handle(), dst.buffer->handle(), 1, &region);
   }
 
   // out = act(conv(in) + bias (+ addend)); out.c must be the layer's output channels.
@@ -154,10 +157,13 @@ class VulkanNetwork::Recorder {
   void observe(const std::string& name, int frame, const View& v) {
     if (!observer_) return;
     barrier();
-    const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * 4, 0, static_cast<VkDeviceSize>(v.count()) * 4};
+    const VkDeviceSize e = net_.elem_;
+    const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
     vkCmdCopyBuffer(commands_, v.buffer->handle(), net_.readback_.handle(), 1, &region);
     run();
-    const float* planar = net_.readback_.mapped();
+    net_.staging_.resize(static_cast<std::size_t>(v.count()));
+    net_.load(net_.readback_.mapped(), net_.staging_.size(), net_.staging_.data());
+    const float* planar = net_.staging_.data();
     const std::size_t plane = static_cast<std::size_t>(v.h) * v.w;
     nhwc_.resize(plane * v.c);
     for (int c = 0; c < v.c; ++c) {
@@ -178,6 +184,8 @@ class VulkanNetwork::Recorder {
 VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width)
     : weights_(std::move(weights)),
       device_(*weights_->device),
+      fp16_(weights_->fp16),
+      elem_(fp16_ ? 2 : 4),
       height_(height),
       width_(width),
       h8_(height / 8),
@@ -189,11 +197,12 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   const std::size_t hw = static_cast<std::size_t>(height) * width, hw8 = static_cast<std::size_t>(h8_) * w8_;
   const std::size_t l = tokens_;
   using M = VulkanDevice::Memory;
-  const auto make = [&](std::size_t floats, const char* what, M memory = M::device) {
-    return device_.create_buffer(floats * sizeof(float), memory, std::string(what) + " at " + std::to_string(width) +
-                                                                     "x" + std::to_string(height));
+  const auto make = [&](std::size_t values, const char* what, M memory = M::device) {
+    return device_.create_buffer(values * elem_, memory, std::string(what) + " at " + std::to_string(width) + "x" +
+                                                             std::to_string(height));
   };
   dummy_ = make(4, "a placeholder binding");
+  zeros_ = make(kHidden * hw8 + 2, "zeros");
   upload_ = make(3 * hw, "the frame upload", M::upload);
   readback_ = make(std::max(192 * hw8, 2 * hw), "the read-back buffer", M::readback);
   input_ = make(3 * hw, "the input frame");
@@ -262,9 +271,9 @@ VulkanNetwork::~VulkanNetwork() {
 
 // What no pass writes: the position channels of f16, the matching grid, the radius planes.
 void VulkanNetwork::initialise_constants() {
-  const std::size_t l = tokens_;
-  Buffer staging = device_.create_buffer(4 * l * sizeof(float), VulkanDevice::Memory::upload, "constants");
-  float* c = staging.mapped();
+  const std::size_t l = tokens_, hw8 = static_cast<std::size_t>(h8_) * w8_;
+  // Positions (2·L), the grid (2·L), then radius planes of 4.0 (as many as the larger plane).
+  std::vector<float> c(4 * l + hw8, 4.f);
   for (int y = 0; y < h16_; ++y) {
     for (int x = 0; x < w16_; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * w16_ + x;
@@ -274,21 +283,40 @@ void VulkanNetwork::initialise_constants() {
       c[3 * l + p] = static_cast<float>(y);                                     // grid y
     }
   }
+  Buffer staging = device_.create_buffer(c.size() * elem_, VulkanDevice::Memory::upload, "constants");
+  store(c.data(), c.size(), staging.mapped());
+  const VkDeviceSize e = elem_;
   OneShotCommands commands(device_);
   VkCommandBuffer cb = commands.buffer();
   for (auto& s : slots_) {
-    const VkBufferCopy pos{0, 190 * l * 4, 2 * l * 4};
+    const VkBufferCopy pos{0, 190 * l * e, 2 * l * e};
     vkCmdCopyBuffer(cb, staging.handle(), s.f16.handle(), 1, &pos);
   }
-  const VkBufferCopy grid{2 * l * 4, 0, 2 * l * 4};
+  const VkBufferCopy grid{2 * l * e, 0, 2 * l * e};
   vkCmdCopyBuffer(cb, staging.handle(), grid_.handle(), 1, &grid);
-  const float radius = 4.f;
-  uint32_t bits;
-  std::memcpy(&bits, &radius, 4);
-  const std::size_t hw8 = static_cast<std::size_t>(h8_) * w8_;
-  vkCmdFillBuffer(cb, refine16_.constant_in.handle(), kContext * l * 4, l * 4, bits);
-  vkCmdFillBuffer(cb, refine8_.constant_in.handle(), kContext * hw8 * 4, hw8 * 4, bits);
+  const VkBufferCopy radius16{4 * l * e, kContext * l * e, l * e}, radius8{4 * l * e, kContext * hw8 * e, hw8 * e};
+  vkCmdCopyBuffer(cb, staging.handle(), refine16_.constant_in.handle(), 1, &radius16);
+  vkCmdCopyBuffer(cb, staging.handle(), refine8_.constant_in.handle(), 1, &radius8);
+  vkCmdFillBuffer(cb, zeros_.handle(), 0, VK_WHOLE_SIZE, 0);
   commands.run();
+}
+
+void VulkanNetwork::store(const float* values, std::size_t count, void* device_memory) const {
+  if (fp16_) {
+    auto* out = static_cast<std::uint16_t*>(device_memory);
+    for (std::size_t i = 0; i < count; ++i) out[i] = to_half(values[i]);
+  } else {
+    std::memcpy(device_memory, values, count * sizeof(float));
+  }
+}
+
+void VulkanNetwork::load(const void* device_memory, std::size_t count, float* values) const {
+  if (fp16_) {
+    const auto* in = static_cast<const std::uint16_t*>(device_memory);
+    for (std::size_t i = 0; i < count; ++i) values[i] = from_half(in[i]);
+  } else {
+    std::memcpy(values, device_memory, count * sizeof(float));
+  }
 }
 
 VkDescriptorSet VulkanNetwork::descriptor_set(const std::array<VkBuffer, 4>& buffers) {
@@ -366,13 +394,15 @@ VkCommandBuffer VulkanNetwork::cached(const std::string& key, int slot0, int slo
 
 void VulkanNetwork::encode(const Tensor& image, int slot) {
   // Planar upload: the device layout is [C][H][W].
-  float* dst = upload_.mapped();
   const std::size_t hw = static_cast<std::size_t>(height_) * width_;
+  staging_.resize(3 * hw);
+  float* dst = staging_.data();
   for (std::size_t p = 0; p < hw; ++p) {
     dst[p] = image.data[3 * p];
     dst[hw + p] = image.data[3 * p + 1];
     dst[2 * hw + p] = image.data[3 * p + 2];
   }
+  store(staging_.data(), staging_.size(), upload_.mapped());
   device_.submit_and_wait(cached("encode" + std::to_string(slot), slot, 0, nullptr), fence_);
 }
 
@@ -389,8 +419,10 @@ void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Ten
     device_.submit_and_wait(cached(key, slot0, slot1, &iterations), fence_);
   }
   out.resize(height_, width_, 2);
-  const float* planar = readback_.mapped();
   const std::size_t hw = static_cast<std::size_t>(height_) * width_;
+  staging_.resize(2 * hw);
+  load(readback_.mapped(), staging_.size(), staging_.data());
+  const float* planar = staging_.data();
   for (std::size_t p = 0; p < hw; ++p) {
     out.data[2 * p] = planar[p];
     out.data[2 * p + 1] = planar[hw + p];
@@ -463,7 +495,7 @@ void VulkanNetwork::record_refinement(Recorder& r, const DeviceRefine& w, Refine
   const View input{&b.input, 0, kRefineInput, h, wd};
   const View constant_out{&b.constant_out, 0, 128, h, wd};
   r.conv(w.conv1_constant, View{&b.constant_in, 0, kContext + 1, h, wd}, 1, 1, kNone, constant_out);
-  r.fill(input.channels(kHiddenOffset, kHidden), 0.f);
+  r.zero(input.channels(kHiddenOffset, kHidden));
   r.copy(flow, input.channels(kFlowOffset, 2));
   const int inter = w.conv2.out_channels;
   for (int i = 0; i < iterations; ++i) {

@@ -63,12 +63,18 @@ class VulkanNetwork {
   VkCommandBuffer cached(const std::string& key, int slot0, int slot1, const Iterations* iterations);
   VkDescriptorSet descriptor_set(const std::array<VkBuffer, 4>& buffers);
   void initialise_constants();
+  // Host values to and from the device's storage type.
+  void store(const float* values, std::size_t count, void* device_memory) const;
+  void load(const void* device_memory, std::size_t count, float* values) const;
 
   std::shared_ptr<const DeviceWeights> weights_;
   VulkanDevice& device_;
+  bool fp16_;          // tensors stored as float16_t
+  std::size_t elem_;   // bytes per stored value: 4 or 2
   int height_, width_, h8_, w8_, h16_, w16_, tokens_, block_rows_;
 
-  Buffer dummy_, upload_, readback_;
+  Buffer dummy_, zeros_, upload_, readback_;
+  std::vector<float> staging_;  // host-side frame or read-back, as floats
   Buffer input_, half_, quarter_, eighth_, encode_tmp_, cat8_, cat16_;
   std::array<Slot, kSlots> slots_;
   Buffer q_, k_, v_, scores_, message_, attn_tmp_, mlp_in_, mlp_hidden_, state0_, state1_;

@@ -13,7 +13,9 @@ namespace {
 
 struct VulkanContext {};
 
-std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>&, int) { unavailable(); }
+std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>&, int, Precision, std::string&) {
+  unavailable();
+}
 std::string describe(const VulkanContext&) { return "vulkan"; }
 std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<VulkanContext>&, int, int) {
   unavailable();

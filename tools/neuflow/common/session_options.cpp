@@ -50,6 +50,12 @@ void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions 
                   "Vulkan device index, as `neuflow devices` lists them (-1: the first GPU)")
       ->capture_default_str()
       ->check(CLI::Range(-1, L::max_device));
+  command
+      .add_option("--precision", args.precision,
+                  "What a Vulkan device stores tensors in: fp32 (exact), or fp16 (half the memory; devices with "
+                  "shaderFloat16, else fp32 with a warning). The CPU computes in fp32")
+      ->check(CLI::IsMember({"fp32", "fp16"}))
+      ->capture_default_str();
 }
 
 void announce_backend(const model::FlowSession& session, const char* subcommand) {
@@ -70,6 +76,7 @@ model::SessionOptions session_options(const SessionArgs& args) {
   options.network_order = args.bgr_alias ? model::ChannelOrder::bgr
                                          : model::parse_channel_order(args.channel_order).value_or(model::ChannelOrder::rgb);
   options.backend = model::parse_backend(args.backend).value_or(model::Backend::automatic);
+  options.precision = model::parse_precision(args.precision).value_or(model::Precision::fp32);
   if (auto problem = model::check_session_options(options)) throw CommandError(kExitUsage, "--" + *problem);
   return options;
 }

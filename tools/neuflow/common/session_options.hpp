@@ -19,6 +19,7 @@ struct SessionArgs {
   std::string size_alias;  // --size WxH
   bool bgr_alias = false;  // --bgr
   std::string backend{model::backend_name(model::SessionOptions{}.backend)};
+  std::string precision{model::precision_name(model::SessionOptions{}.precision)};
 };
 
 enum class ModelSizeOptions { offered, not_offered };

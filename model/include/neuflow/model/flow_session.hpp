@@ -55,8 +55,8 @@ class FlowSession {
 
   // Where the network runs: "cpu" or "vulkan device 0 (NVIDIA H200)".
   const std::string& backend_description() const;
-  // With backend=auto, why a GPU that was found is not used (the session then runs on the
-  // CPU); empty otherwise. Callers report it once.
+  // What the session does other than asked, once: backend=auto leaving a GPU it found for the
+  // CPU, or fp16 on a device without it running fp32. Empty otherwise. Callers report it once.
   const std::string& fallback_warning() const;
 
   struct State;  // opaque per-session buffers and stream state

@@ -16,6 +16,12 @@ enum class ChannelOrder { rgb, bgr };
 // software one such as lavapipe included) and fails when there is none.
 enum class Backend { automatic, cpu, vulkan };
 
+// What a Vulkan session stores its tensors in: fp32 (exact to the reference), or fp16 (half
+// the memory and memory traffic, arithmetic still accumulated in fp32) on devices with
+// shaderFloat16 and 16-bit storage; elsewhere fp16 runs as fp32 with a warning. The CPU
+// computes in fp32 either way.
+enum class Precision { fp32, fp16 };
+
 struct Iterations {
   int s16 = 1;  // refinement iterations at 1/16
   int s8 = 8;   // refinement iterations at 1/8
@@ -48,6 +54,7 @@ struct SessionOptions {
   // A Vulkan device's index (`neuflow devices` lists them), or -1: the first discrete or
   // integrated GPU (for `vulkan` without one, the first device).
   int device = -1;
+  Precision precision = Precision::fp32;
   bool operator==(const SessionOptions&) const = default;
 };
 
@@ -79,6 +86,9 @@ std::optional<ChannelOrder> parse_channel_order(std::string_view name);
 constexpr std::string_view backend_name(Backend backend) {
   return backend == Backend::cpu ? "cpu" : backend == Backend::vulkan ? "vulkan" : "auto";
 }
-std::optional<Backend> parse_backend(std::string_view name);  // "auto", "cpu", "vulkan"
+std::optional<Backend> parse_backend(std::string_view name);
+
+constexpr std::string_view precision_name(Precision precision) { return precision == Precision::fp16 ? "fp16" : "fp32"; }
+std::optional<Precision> parse_precision(std::string_view name);  // "fp32", "fp16"  // "auto", "cpu", "vulkan"
 
 }  // namespace neuflow::model

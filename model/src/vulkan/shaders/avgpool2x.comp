@@ -1,9 +1,10 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#include "precision.glsl"
 // 2×2 average pooling of a planar [C][H][W] tensor.
 #include "common.glsl"
-layout(std430, binding = 0) readonly buffer In { float src[]; };
-layout(std430, binding = 2) writeonly buffer Out { float dst[]; };
+layout(std430, binding = 0) readonly buffer In { VALUE src[]; };
+layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(push_constant) uniform Params { int channels, in_h, in_w; } p;
 
 void main() {
@@ -12,6 +13,6 @@ void main() {
     const int c = i / (oh * ow), r = i - c * oh * ow;
     const int y = r / ow, x = r - y * ow;
     const int base = c * p.in_h * p.in_w + 2 * y * p.in_w + 2 * x;
-    dst[i] = (src[base] + src[base + 1] + src[base + p.in_w] + src[base + p.in_w + 1]) * 0.25;
+    dst[i] = VALUE((float(src[base]) + float(src[base + 1]) + float(src[base + p.in_w]) + float(src[base + p.in_w + 1])) * 0.25);
   }
 }

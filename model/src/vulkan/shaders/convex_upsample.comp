@@ -1,12 +1,13 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#include "precision.glsl"
 // Convex upsampling ×8: output pixel (8y + a, 8x + b) = 8 · Σ_k softmax_k(mask[k·64 + a·8 + b])
 // · flow8[3×3 neighbour k of (y, x)], zero outside. Planar mask [576][h8·w8], flow8 [2][h8·w8],
 // output [2][8h8][8w8].
 #include "common.glsl"
-layout(std430, binding = 0) readonly buffer Mask { float mask[]; };
-layout(std430, binding = 1) readonly buffer Flow8 { float flow8[]; };
-layout(std430, binding = 2) writeonly buffer Out { float dst[]; };
+layout(std430, binding = 0) readonly buffer Mask { VALUE mask[]; };
+layout(std430, binding = 1) readonly buffer Flow8 { VALUE flow8[]; };
+layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(push_constant) uniform Params { int h8, w8; } p;
 
 void main() {
@@ -18,7 +19,7 @@ void main() {
     float logit[9];
     float m = -3.402823e38;
     for (int k = 0; k < 9; ++k) {
-      logit[k] = mask[(k * 64 + a * 8 + b) * plane8 + y * p.w8 + x];
+      logit[k] = float(mask[(k * 64 + a * 8 + b) * plane8 + y * p.w8 + x]);
       m = max(m, logit[k]);
     }
     float sum = 0.0, u = 0.0, v = 0.0;
@@ -28,11 +29,11 @@ void main() {
       const bool inside = yy >= 0 && yy < p.h8 && xx >= 0 && xx < p.w8;
       sum += e;
       if (inside) {
-        u += e * flow8[yy * p.w8 + xx];
-        v += e * flow8[plane8 + yy * p.w8 + xx];
+        u += e * float(flow8[yy * p.w8 + xx]);
+        v += e * float(flow8[plane8 + yy * p.w8 + xx]);
       }
     }
-    dst[i] = 8.0 * u / sum;
-    dst[H * W + i] = 8.0 * v / sum;
+    dst[i] = VALUE(8.0 * u / sum);
+    dst[H * W + i] = VALUE(8.0 * v / sum);
   }
 }

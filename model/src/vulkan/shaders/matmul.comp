@@ -1,4 +1,6 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
+#include "precision.glsl"
 // C = act(alpha · A · B + bias + addend), tiled through workgroup memory: 64×64 outputs per
 // workgroup, 4×4 per invocation, K in steps of 16. Compiled twice:
 //  - IMPLICIT_CONV: A is a convolution's OIHW weights read as a row-major [Cout][Cin·k·k]
@@ -9,10 +11,10 @@
 //    column stride, so transposes are free.
 layout(local_size_x = 16, local_size_y = 16) in;
 
-layout(std430, binding = 0) readonly buffer BufA { float a_data[]; };
-layout(std430, binding = 1) readonly buffer BufB { float b_data[]; };
-layout(std430, binding = 2) buffer BufC { float c_data[]; };
-layout(std430, binding = 3) readonly buffer BufD { float d_data[]; };  // the addend
+layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
+layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
+layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
+layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend
 
 #ifdef IMPLICIT_CONV
 layout(push_constant) uniform Params {
@@ -87,9 +89,9 @@ void main() {
       float v = 0.0;
       if (gm < M && gk < K) {
 #ifdef IMPLICIT_CONV
-        v = a_data[p.w_off + gm * K + gk];
+        v = float(a_data[p.w_off + gm * K + gk]);
 #else
-        v = a_data[p.a_off + gm * p.a_rs + gk * p.a_cs];
+        v = float(a_data[p.a_off + gm * p.a_rs + gk * p.a_cs]);
 #endif
       }
       tile_a[kk][mm] = v;
@@ -106,12 +108,12 @@ void main() {
         const int ky = rem / p.kernel, kx = rem - ky * p.kernel;
         const int iy = iy0 + ky, ix = ix0 + kx;
         if (iy >= 0 && iy < p.in_h && ix >= 0 && ix < p.in_w) {
-          v = b_data[p.in_off + ci * in_plane + iy * p.in_w + ix];
+          v = float(b_data[p.in_off + ci * in_plane + iy * p.in_w + ix]);
         }
       }
 #else
       const int gn = col0 + nn;
-      if (gn < N && gk < K) v = b_data[p.b_off + gk * p.b_rs + gn * p.b_cs];
+      if (gn < N && gk < K) v = float(b_data[p.b_off + gk * p.b_rs + gn * p.b_cs]);
 #endif
       tile_b[kk][nn] = v;
     }
@@ -130,20 +132,20 @@ void main() {
     const int gm = row0 + ty + 16 * i;
     if (gm >= M) continue;
 #ifdef IMPLICIT_CONV
-    const float bias = p.bias_off >= 0 ? a_data[p.bias_off + gm] : 0.0;
+    const float bias = p.bias_off >= 0 ? float(a_data[p.bias_off + gm]) : 0.0;
     for (int j = 0; j < 4; ++j) {
       const int gn = col0 + tx + 16 * j;
       if (gn >= N) continue;
       float v = p.alpha * acc[i][j] + bias;
-      if (p.add_off >= 0) v += d_data[p.add_off + gm * N + gn];
-      c_data[p.out_off + gm * N + gn] = activate(v, p.act);
+      if (p.add_off >= 0) v += float(d_data[p.add_off + gm * N + gn]);
+      c_data[p.out_off + gm * N + gn] = VALUE(activate(v, p.act));
     }
 #else
-    const float bias = p.bias_off >= 0 ? a_data[p.bias_off + gm] : 0.0;
+    const float bias = p.bias_off >= 0 ? float(a_data[p.bias_off + gm]) : 0.0;
     for (int j = 0; j < 4; ++j) {
       const int gn = col0 + tx + 16 * j;
       if (gn >= N) continue;
-      c_data[p.c_off + gm * p.c_rs + gn * p.c_cs] = activate(p.alpha * acc[i][j] + bias, p.act);
+      c_data[p.c_off + gm * p.c_rs + gn * p.c_cs] = VALUE(activate(p.alpha * acc[i][j] + bias, p.act));
     }
 #endif
   }

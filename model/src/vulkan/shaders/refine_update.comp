@@ -1,23 +1,24 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#include "precision.glsl"
 // The end of a refinement step: from conv3's output [delta 2, hidden 64], flow += delta, and
 // the clamped hidden state and the new flow go into the next step's input
 // [corr 81, hidden 64, flow 2].
 #include "common.glsl"
-layout(std430, binding = 0) readonly buffer Conv3 { float o[]; };
-layout(std430, binding = 2) buffer Input { float input_data[]; };
-layout(std430, binding = 3) buffer Flow { float flow[]; };
+layout(std430, binding = 0) readonly buffer Conv3 { VALUE o[]; };
+layout(std430, binding = 2) buffer Input { VALUE input_data[]; };
+layout(std430, binding = 3) buffer Flow { VALUE flow[]; };
 layout(push_constant) uniform Params { int plane, hidden_off, flow_in_off, flow_off; } p;
 
 void main() {
   FOR_EACH(pix, p.plane) {
     for (int c = 0; c < 64; ++c) {
-      input_data[p.hidden_off + c * p.plane + pix] = clamp(o[(2 + c) * p.plane + pix], -4.0, 4.0);
+      input_data[p.hidden_off + c * p.plane + pix] = VALUE(clamp(float(o[(2 + c) * p.plane + pix]), -4.0, 4.0));
     }
     for (int d = 0; d < 2; ++d) {
-      const float v = flow[p.flow_off + d * p.plane + pix] + o[d * p.plane + pix];
-      flow[p.flow_off + d * p.plane + pix] = v;
-      input_data[p.flow_in_off + d * p.plane + pix] = v;
+      const float v = float(flow[p.flow_off + d * p.plane + pix]) + float(o[d * p.plane + pix]);
+      flow[p.flow_off + d * p.plane + pix] = VALUE(v);
+      input_data[p.flow_in_off + d * p.plane + pix] = VALUE(v);
     }
   }
 }

@@ -1,7 +1,9 @@
 #version 450
+#extension GL_GOOGLE_include_directive : require
+#include "precision.glsl"
 // In place: each row of a [rows][cols] matrix becomes its softmax. One workgroup per row.
 layout(local_size_x = 256) in;
-layout(std430, binding = 2) buffer Data { float data[]; };
+layout(std430, binding = 2) buffer Data { VALUE data[]; };
 layout(push_constant) uniform Params { int rows, cols, off; } p;
 shared float partial[256];
 
@@ -10,7 +12,7 @@ void main() {
   if (row >= p.rows) return;  // uniform per workgroup
   const int base = p.off + row * p.cols;
   float m = -3.402823e38;
-  for (int i = t; i < p.cols; i += 256) m = max(m, data[base + i]);
+  for (int i = t; i < p.cols; i += 256) m = max(m, float(data[base + i]));
   partial[t] = m;
   barrier();
   for (int s = 128; s > 0; s >>= 1) {
@@ -21,8 +23,8 @@ void main() {
   barrier();
   float sum = 0.0;
   for (int i = t; i < p.cols; i += 256) {
-    const float e = exp(data[base + i] - m);
-    data[base + i] = e;
+    const float e = exp(float(data[base + i]) - m);
+    data[base + i] = VALUE(e);
     sum += e;
   }
   partial[t] = sum;
@@ -32,5 +34,5 @@ void main() {
     barrier();
   }
   const float inv = 1.0 / partial[0];
-  for (int i = t; i < p.cols; i += 256) data[base + i] *= inv;
+  for (int i = t; i < p.cols; i += 256) data[base + i] = VALUE(float(data[base + i]) * inv);
 }
