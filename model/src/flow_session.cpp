@@ -54,6 +54,9 @@ FlowSession::FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions 
       } catch (const BackendError& e) {
         s.fallback = std::string("backend auto: ") + e.what() + "; running on the CPU instead";
       }
+    } else if (options_.device >= 0) {
+      s.fallback = "backend auto: no Vulkan device " + std::to_string(options_.device) +
+                   " (`neuflow devices` lists them); running on the CPU instead";
     }
   }
   if (s.vulkan) s.description = describe(*s.vulkan);

@@ -140,6 +140,7 @@ struct State {
   neuflow::gst::FrameConverter converter;
   GstClockTime previous_pts = GST_CLOCK_TIME_NONE;
   guint64 previous_frame = 0;
+  std::string reported_fallback;  // the session's fallback warning, once posted
 };
 
 }  // namespace
@@ -289,6 +290,14 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
   }
   gst_video_frame_unmap(&frame);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  // backend=auto can leave the GPU at the first frame (its plan does not fit): say so once.
+  if (st.session->fallback_warning() != st.reported_fallback) {
+    st.reported_fallback = st.session->fallback_warning();
+    GST_ELEMENT_WARNING(self, RESOURCE, FAILED, ("%s", st.reported_fallback.c_str()), (nullptr));
+    GST_OBJECT_LOCK(self);
+    self->settings->running_on = st.session->backend_description();
+    GST_OBJECT_UNLOCK(self);
+  }
 
   const GstClockTime pts = GST_BUFFER_PTS(buffer);
   if (flow) {
@@ -624,8 +633,9 @@ GstStateChangeReturn change_state(GstElement *element, GstStateChange transition
         GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("invalid settings: %s", e.what()), (nullptr));
         return GST_STATE_CHANGE_FAILURE;
       }
-      if (!st.session->fallback_warning().empty()) {
-        GST_ELEMENT_WARNING(self, RESOURCE, FAILED, ("%s", st.session->fallback_warning().c_str()), (nullptr));
+      st.reported_fallback = st.session->fallback_warning();
+      if (!st.reported_fallback.empty()) {
+        GST_ELEMENT_WARNING(self, RESOURCE, FAILED, ("%s", st.reported_fallback.c_str()), (nullptr));
       }
       GST_INFO_OBJECT(self, "running on %s", st.session->backend_description().c_str());
       GST_OBJECT_LOCK(self);

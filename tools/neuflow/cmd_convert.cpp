@@ -112,7 +112,7 @@ void run_convert(const ConvertArgs& a) {
     throw CommandError(exit_code_for(e), e.what());
   }
   model::FlowSession session(model, options);
-  announce_backend(session, "convert");
+  std::string announced = announce_backend(session, "convert");
 
   ConvertSettings settings;
   settings.output_dir = a.output;
@@ -145,6 +145,7 @@ void run_convert(const ConvertArgs& a) {
   std::vector<InputOutcome> outcomes;
   for (const auto& input : inputs) {
     outcomes.push_back(convert_input(input, session, settings, progress));
+    report_late_fallback(session, "convert", announced);
     // Said at once, so a long batch does not hide an early failure until the end.
     if (outcomes.back().error) progress.print(failure_text(input, *outcomes.back().error));
   }

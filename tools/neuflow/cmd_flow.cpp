@@ -52,7 +52,7 @@ void run_flow(const FlowArgs& a) {
   }
   const auto model = load_model(a.model);
   model::FlowSession session(model, options);
-  announce_backend(session, "flow");
+  std::string announced = announce_backend(session, "flow");
   const auto view = [](const cv::Mat& m) {  // OpenCV decodes to BGR
     return model::ImageView{m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), model::ChannelOrder::bgr};
   };
@@ -64,6 +64,7 @@ void run_flow(const FlowArgs& a) {
     throw CommandError(kExitDataError, e.what());
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  report_late_fallback(session, "flow", announced);
 
   try {
     flow::write_flow(field, a.output);

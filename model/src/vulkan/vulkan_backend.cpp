@@ -39,6 +39,9 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
            " has no shaderFloat16 and 16-bit storage (Vulkan 1.2); running in fp32 instead";
     fp16 = false;
   }
+  if (fp16) {  // created now, so a driver that refuses one says so before the first frame
+    for (std::size_t s = 0; s < vulkan::kShaderCount; ++s) device->pipeline(static_cast<vulkan::Shader>(s), true);
+  }
   auto context = std::make_shared<VulkanContext>();
   context->weights = vulkan::DeviceWeights::get(model, device, fp16);
   return context;

@@ -61,6 +61,19 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
                            std::to_string(devices.size()) + " (0 to " + std::to_string(devices.size() - 1) +
                            "; `neuflow devices` lists them)");
   }
+  // What the shaders need: Vulkan 1.1 SPIR-V, workgroups of 256 invocations (16×16 tiles).
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(devices[static_cast<std::size_t>(index)], &props);
+  const std::string label = "vulkan device " + std::to_string(index) + " (" + props.deviceName + ")";
+  if (props.apiVersion < VK_API_VERSION_1_1) {
+    throw BackendError(BackendError::Kind::unavailable, label + ": supports only Vulkan 1.0; the shaders need 1.1");
+  }
+  if (props.limits.maxComputeWorkGroupInvocations < 256 || props.limits.maxComputeWorkGroupSize[0] < 256 ||
+      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 8192) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       label + ": compute workgroups are too small for the shaders (they need 256 invocations and "
+                               "8 KiB of shared memory)");
+  }
   const std::lock_guard lock(mutex);
   if (auto device = opened[index].lock(); device && !device->lost_) return device;
   auto device = std::shared_ptr<VulkanDevice>(new VulkanDevice(devices[static_cast<std::size_t>(index)], index));

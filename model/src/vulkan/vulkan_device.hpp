@@ -3,6 +3,7 @@
 // shader, created once and shared by all sessions on that device (open() hands out the same
 // instance while anyone holds it).
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -105,7 +106,7 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   std::mutex memory_mutex_;
   std::size_t allocated_ = 0;
   std::size_t budget_ = 0;  // 0: no budget
-  bool lost_ = false;
+  std::atomic<bool> lost_{false};
 };
 
 }  // namespace neuflow::model::vulkan

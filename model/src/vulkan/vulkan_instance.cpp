@@ -25,7 +25,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverity
   ++validation_messages;
   std::fprintf(stderr, "neuflow: Vulkan validation %s: %s\n", error ? "error" : "warning",
                data && data->pMessage ? data->pMessage : "(no text)");
-  if (std::strcmp(std::getenv("NEUFLOW_VULKAN_VALIDATION"), "fatal") == 0) std::abort();
+  const char* mode = std::getenv("NEUFLOW_VULKAN_VALIDATION");
+  if (mode != nullptr && std::strcmp(mode, "fatal") == 0) std::abort();
   return VK_FALSE;
 }
 

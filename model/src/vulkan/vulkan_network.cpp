@@ -32,8 +32,20 @@ struct MatmulPush {
   float alpha;
 };
 
+// Element-wise shaders loop over what a capped dispatch does not cover (common.glsl).
 uint32_t groups(long count, long per_group) {
   return static_cast<uint32_t>(std::clamp<long>((count + per_group - 1) / per_group, 1, 65535));
+}
+
+// The tiled products do not loop: each workgroup is one 64×64 tile, so the grid must fit.
+uint32_t tiles(long count, const char* what) {
+  const long n = (count + 63) / 64;
+  if (n > 65535) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       std::string("a model size too large for one dispatch of ") + what +
+                           ": choose a smaller model-width/model-height");
+  }
+  return static_cast<uint32_t>(std::max<long>(n, 1));
 }
 
 }  // namespace
@@ -58,6 +70,15 @@ class VulkanNetwork::Recorder {
   void run() {
     end();
     net_.device_.submit_and_wait(commands_, net_.fence_);
+  }
+
+  // Makes a copy into a host-visible buffer visible to the host once the fence has signalled.
+  void host_barrier() {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr, 0,
+                         nullptr);
   }
 
   void barrier() {
@@ -112,7 +133,7 @@ class VulkanNetwork::Recorder {
     ConvPush p{in.c, in.h, in.w, in.offset(), out.c, out.h, out.w, out.offset(), w.kernel, stride, pad, act,
                w.weight, w.bias, addend ? addend->offset() : -1, 1.f};
     dispatch(Shader::conv2d, {&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, &p,
-             sizeof p, groups(static_cast<long>(out.h) * out.w, 64), groups(out.c, 64));
+             sizeof p, tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
   }
 
   // Token lists [features][tokens]: out = act(W · in + b).
@@ -120,12 +141,12 @@ class VulkanNetwork::Recorder {
               Act act = kNone) {
     MatmulPush p{w.out_features, tokens, w.in_features, w.weight, w.in_features, 1, in_off, tokens, 1,
                  out_off, tokens, 1, w.bias, act, 1.f};
-    dispatch(Shader::matmul, {&net_.weights_->buffer, &in, &out, nullptr}, &p, sizeof p, groups(tokens, 64),
-             groups(w.out_features, 64));
+    dispatch(Shader::matmul, {&net_.weights_->buffer, &in, &out, nullptr}, &p, sizeof p, tiles(tokens, "attention"),
+             tiles(w.out_features, "attention"));
   }
 
   void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulPush& p) {
-    dispatch(Shader::matmul, {&a, &b, &c, nullptr}, &p, sizeof p, groups(p.n, 64), groups(p.m, 64));
+    dispatch(Shader::matmul, {&a, &b, &c, nullptr}, &p, sizeof p, tiles(p.n, "attention"), tiles(p.m, "attention"));
   }
 
   void resample(const View& src, const View& dst, int factor, bool relu, float scale) {
@@ -160,6 +181,7 @@ class VulkanNetwork::Recorder {
     const VkDeviceSize e = net_.elem_;
     const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
     vkCmdCopyBuffer(commands_, v.buffer->handle(), net_.readback_.handle(), 1, &region);
+    host_barrier();
     run();
     net_.staging_.resize(static_cast<std::size_t>(v.count()));
     net_.load(net_.readback_.mapped(), net_.staging_.size(), net_.staging_.data());
@@ -253,20 +275,31 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   mask_ = make(576 * hw8, "the upsampling mask");
   flow_full_ = make(2 * hw, "the full-resolution flow");
 
-  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-  pool.queueFamilyIndex = device_.queue_family();
-  device_.check(vkCreateCommandPool(device_.handle(), &pool, nullptr, &pool_), "vkCreateCommandPool");
-  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  device_.check(vkCreateFence(device_.handle(), &fence, nullptr, &fence_), "vkCreateFence");
-  initialise_constants();
+  // The buffers release themselves; the pool and fence are released here if setting up fails.
+  try {
+    VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    pool.queueFamilyIndex = device_.queue_family();
+    device_.check(vkCreateCommandPool(device_.handle(), &pool, nullptr, &pool_), "vkCreateCommandPool");
+    VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    device_.check(vkCreateFence(device_.handle(), &fence, nullptr, &fence_), "vkCreateFence");
+    initialise_constants();
+  } catch (...) {
+    release_handles();
+    throw;
+  }
 }
 
-VulkanNetwork::~VulkanNetwork() {
+VulkanNetwork::~VulkanNetwork() { release_handles(); }
+
+void VulkanNetwork::release_handles() {
   VkDevice d = device_.handle();
   if (fence_ != VK_NULL_HANDLE) vkDestroyFence(d, fence_, nullptr);
   if (pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(d, pool_, nullptr);  // frees its command buffers
   for (VkDescriptorPool p : descriptor_pools_) vkDestroyDescriptorPool(d, p, nullptr);
+  fence_ = VK_NULL_HANDLE;
+  pool_ = VK_NULL_HANDLE;
+  descriptor_pools_.clear();
 }
 
 // What no pass writes: the position channels of f16, the matching grid, the radius planes.
@@ -616,6 +649,7 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   r.dispatch(Shader::convex_upsample, {&mask_, &flow8_, &flow_full_, nullptr}, &cp, sizeof cp,
              groups(static_cast<long>(height_) * width_, kLocal));
   r.copy_raw(flow_full_, readback_, static_cast<std::size_t>(2) * height_ * width_);
+  r.host_barrier();
 }
 
 }  // namespace neuflow::model::vulkan

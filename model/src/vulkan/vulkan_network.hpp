@@ -63,6 +63,7 @@ class VulkanNetwork {
   VkCommandBuffer cached(const std::string& key, int slot0, int slot1, const Iterations* iterations);
   VkDescriptorSet descriptor_set(const std::array<VkBuffer, 4>& buffers);
   void initialise_constants();
+  void release_handles();
   // Host values to and from the device's storage type.
   void store(const float* values, std::size_t count, void* device_memory) const;
   void load(const void* device_memory, std::size_t count, float* values) const;

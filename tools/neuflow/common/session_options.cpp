@@ -58,11 +58,19 @@ void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions 
       ->capture_default_str();
 }
 
-void announce_backend(const model::FlowSession& session, const char* subcommand) {
+void report_late_fallback(const model::FlowSession& session, const char* subcommand, std::string& announced) {
+  if (session.fallback_warning().empty() || session.fallback_warning() == announced) return;
+  announced = session.fallback_warning();
+  std::fprintf(stderr, "neuflow %s: warning: %s (ran on %s)\n", subcommand, session.fallback_warning().c_str(),
+               session.backend_description().c_str());
+}
+
+std::string announce_backend(const model::FlowSession& session, const char* subcommand) {
   if (!session.fallback_warning().empty()) {
     std::fprintf(stderr, "neuflow %s: warning: %s\n", subcommand, session.fallback_warning().c_str());
   }
   std::fprintf(stderr, "neuflow %s: running on %s\n", subcommand, session.backend_description().c_str());
+  return session.fallback_warning();
 }
 
 model::SessionOptions session_options(const SessionArgs& args) {

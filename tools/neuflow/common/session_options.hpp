@@ -33,6 +33,11 @@ model::SessionOptions session_options(const SessionArgs& args);
 
 // One line on stderr saying where the network runs ("neuflow flow: running on vulkan device 0
 // (...)"), and backend=auto's reason for not using a GPU it found, if any.
-void announce_backend(const model::FlowSession& session, const char* subcommand);
+// Returns the warning it printed (empty: none).
+std::string announce_backend(const model::FlowSession& session, const char* subcommand);
+// After the work: a warning that came later than announce_backend (backend=auto leaves the GPU
+// only once it knows the frames' size and the plan does not fit).
+// `announced` is what was said so far; updated.
+void report_late_fallback(const model::FlowSession& session, const char* subcommand, std::string& announced);
 
 }  // namespace neuflow::cli
