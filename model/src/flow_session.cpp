@@ -87,7 +87,6 @@ const FrameGeometry& prepare_plan(FlowSession::State& s, const FlowModel& model,
   if (s.backend && g == s.geometry) return s.geometry;
   if (!s.backend || s.backend->width() != g.model_width || s.backend->height() != g.model_height) {
     s.backend.reset();
-    s.has_previous = false;
     if (s.vulkan) {
       try {
         s.backend = make_vulkan_backend(s.vulkan, g.model_height, g.model_width);

@@ -85,9 +85,6 @@ VulkanDevice::VulkanDevice(VkPhysicalDevice physical, int index)
     : physical_(physical), info_(describe(physical, index)), budget_(budget_from_environment()) {
   label_ = "vulkan device " + std::to_string(index) + " (" + info_.name + ")";
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
-  VkPhysicalDeviceProperties props;
-  vkGetPhysicalDeviceProperties(physical_, &props);
-  timestamp_period_ = props.limits.timestampPeriod;
 
   uint32_t families = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(physical_, &families, nullptr);

@@ -30,7 +30,6 @@ class Buffer {
   VkBuffer handle() const { return buffer_; }
   std::size_t bytes() const { return bytes_; }
   float* mapped() const { return static_cast<float*>(mapped_); }
-  explicit operator bool() const { return buffer_ != VK_NULL_HANDLE; }
 
  private:
   friend class VulkanDevice;
@@ -61,7 +60,6 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   VkPipeline pipeline(Shader shader, bool fp16);
   VkPipelineLayout pipeline_layout() const { return pipeline_layout_; }
   VkDescriptorSetLayout set_layout() const { return set_layout_; }
-  float timestamp_period_ns() const { return timestamp_period_; }
 
   enum class Memory { device, upload, readback };
   // `what` names the buffer in an out-of-memory error. Device memory is held within
@@ -96,7 +94,6 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
   VkPhysicalDeviceMemoryProperties memory_{};
-  float timestamp_period_ = 1.f;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
   std::array<VkPipeline, kShaderCount> pipelines_{};
