@@ -97,7 +97,7 @@ const FrameGeometry& prepare_plan(FlowSession::State& s, const FlowModel& model,
         s.description = "cpu";
       }
     }
-    if (!s.backend) s.backend = make_cpu_backend(model, g.model_height, g.model_width);
+    if (!s.backend) s.backend = make_cpu_backend(model, g.model_height, g.model_width, options.cpu_convolution);
   }
   s.geometry = g;
   s.has_previous = false;

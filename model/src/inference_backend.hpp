@@ -30,6 +30,11 @@ class InferenceBackend {
                     const StageObserver* observer) = 0;
 };
 
-std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width);
+// `convolution` automatic defers to NEUFLOW_CONV (auto, direct or winograd) when it is set.
+std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width,
+                                                   CpuConvolution convolution);
+// The choice a session's plan is built with: `requested`, or for automatic, NEUFLOW_CONV's
+// value when set; std::invalid_argument naming the variable when that value is none of them.
+CpuConvolution resolve_cpu_convolution(CpuConvolution requested);
 
 }  // namespace neuflow::model

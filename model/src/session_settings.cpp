@@ -72,10 +72,6 @@ std::optional<ChannelOrder> parse_channel_order(std::string_view name) {
   return std::nullopt;
 }
 
-}  // namespace neuflow::model
-
-namespace neuflow::model {
-
 std::optional<Precision> parse_precision(std::string_view name) {
   if (name == "fp32") return Precision::fp32;
   if (name == "fp16") return Precision::fp16;
@@ -86,6 +82,13 @@ std::optional<Backend> parse_backend(std::string_view name) {
   if (name == "auto") return Backend::automatic;
   if (name == "cpu") return Backend::cpu;
   if (name == "vulkan") return Backend::vulkan;
+  return std::nullopt;
+}
+
+std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name) {
+  if (name == "auto") return CpuConvolution::automatic;
+  if (name == "direct") return CpuConvolution::direct;
+  if (name == "winograd") return CpuConvolution::winograd;
   return std::nullopt;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 #include "dnnl/context.hpp"
 #include "dnnl/conv_op.hpp"
@@ -80,10 +81,13 @@ struct ConvCase {
   bool accumulate;
 };
 
-class ConvOpTest : public ::testing::TestWithParam<ConvCase> {};
+class ConvOpTest : public ::testing::TestWithParam<std::tuple<ConvCase, CpuConvolution>> {};
 
+// Both ways of computing a convolution: oneDNN's direct one and (for stride-1 3×3 layers)
+// Winograd F(4×4, 3×3); each against the definition in double.
 TEST_P(ConvOpTest, MatchesNaiveConvolution) {
-  const ConvCase p = GetParam();
+  const ConvCase p = std::get<0>(GetParam());
+  const CpuConvolution algorithm = std::get<1>(GetParam());
   std::mt19937 rng(11);
   ConvWeights w{p.out_c, p.in_c, p.k, p.k, std::vector<float>(static_cast<std::size_t>(p.out_c) * p.in_c * p.k * p.k), {}};
   fill_random(w.weight, rng, 0.1f);
@@ -94,9 +98,10 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
   Tensor in(p.h, p.w, p.in_c), out, addend_t;
   fill_random(in.data, rng);
   dnnl::stream stream(cpu_engine());
-  ScratchArena arena;
-  ConvOp op(w, {p.stride, p.pad, p.act, p.accumulate}, nhwc_desc(p.h, p.w, p.in_c), arena);
-  arena.finalize();
+  PlanContext context{{}, algorithm};
+  ConvOp op(w, {p.stride, p.pad, p.act, p.accumulate}, nhwc_desc(p.h, p.w, p.in_c), context);
+  context.arena.finalize();
+  ASSERT_EQ(op.is_winograd(), algorithm == CpuConvolution::winograd && p.k == 3 && p.stride == 1);
   std::optional<dnnl::memory> addend;
   if (p.accumulate) {
     addend_t.resize(op.out_h(), op.out_w(), p.out_c);
@@ -128,14 +133,17 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
 // The shapes the network uses: the backbone's strided first convolutions on 3 channels,
 // channel counts that are not multiples of 8, fused activations and the accumulate path.
 INSTANTIATE_TEST_SUITE_P(NetworkShapes, ConvOpTest,
-                         ::testing::Values(ConvCase{3, 16, 8, 4, 2, 24, 32, false, Activation::leaky_relu, false},
+                         ::testing::Combine(::testing::Values(ConvCase{3, 16, 8, 4, 2, 24, 32, false, Activation::leaky_relu, false},
                                            ConvCase{3, 16, 6, 2, 2, 12, 16, false, Activation::leaky_relu, false},
                                            ConvCase{3, 8, 8, 8, 0, 16, 24, false, Activation::leaky_relu, false},
                                            ConvCase{147, 24, 3, 1, 1, 5, 7, false, Activation::leaky_relu, true},
                                            ConvCase{96, 66, 3, 1, 1, 6, 5, true, Activation::none, false},
                                            ConvCase{130, 32, 3, 1, 1, 4, 6, true, Activation::relu, false},
                                            ConvCase{64, 40, 1, 1, 0, 4, 4, true, Activation::none, false},
-                                           ConvCase{40, 24, 3, 1, 1, 5, 5, false, Activation::gelu, false}));
+                                           ConvCase{40, 24, 3, 1, 1, 5, 5, false, Activation::gelu, false},
+                                           // Several tiles, borders cut inside a tile, channels past one block.
+                                           ConvCase{20, 36, 3, 1, 1, 13, 18, true, Activation::leaky_relu, true}),
+                                           ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd)));
 
 }  // namespace
 }  // namespace neuflow::model

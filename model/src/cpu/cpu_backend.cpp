@@ -1,4 +1,7 @@
 #include <array>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
 
 #include "dnnl/context.hpp"
 #include "inference_backend.hpp"
@@ -11,7 +14,8 @@ namespace {
 // Today's oneDNN network behind the backend interface; the frames' features stay in host memory.
 class CpuBackend final : public InferenceBackend {
  public:
-  CpuBackend(const NetworkWeights& weights, int height, int width) : plan_(weights, height, width) {}
+  CpuBackend(const NetworkWeights& weights, int height, int width, CpuConvolution convolution)
+      : plan_(weights, height, width, convolution) {}
   int width() const override { return plan_.width(); }
   int height() const override { return plan_.height(); }
   void encode(const Tensor& image, int slot) override { plan_.encode(stream_, image, slots_[static_cast<std::size_t>(slot)]); }
@@ -28,8 +32,17 @@ class CpuBackend final : public InferenceBackend {
 
 }  // namespace
 
-std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width) {
-  return std::make_unique<CpuBackend>(model.weights(), height, width);
+CpuConvolution resolve_cpu_convolution(CpuConvolution requested) {
+  if (requested != CpuConvolution::automatic) return requested;
+  const char* env = std::getenv("NEUFLOW_CONV");
+  if (!env || !*env) return requested;
+  if (const auto parsed = parse_cpu_convolution(env)) return *parsed;
+  throw std::invalid_argument(std::string("NEUFLOW_CONV: expected auto, direct or winograd, got \"") + env + "\"");
+}
+
+std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width,
+                                                   CpuConvolution convolution) {
+  return std::make_unique<CpuBackend>(model.weights(), height, width, resolve_cpu_convolution(convolution));
 }
 
 }  // namespace neuflow::model

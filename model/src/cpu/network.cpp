@@ -19,26 +19,27 @@ ChannelSlice features_of(const Tensor& t) { return {&t, kContext, kFeatures}; }
 ChannelSlice context_of(const Tensor& t) { return {&t, 0, kContext}; }
 
 // Starts a new arena region: the stage constructed with it may reuse earlier stages' memory.
-ScratchArena& next_region(ScratchArena& arena) {
-  arena.next_region();
-  return arena;
+PlanContext& next_region(PlanContext& context) {
+  context.arena.next_region();
+  return context;
 }
 
 }  // namespace
 
-NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width)
+NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width, CpuConvolution convolution)
     : height_(height),
       width_(width),
-      encoder_(w, height, width, arena_),
+      context_{{}, convolution},
+      encoder_(w, height, width, context_),
       attention_(w, height / 16, width / 16),
       matching_(height / 16, width / 16, kFeatures),
-      refine_s16_(w.refine_s16, height / 16, width / 16, next_region(arena_)),
-      merge_(w, height / 8, width / 8, next_region(arena_)),
-      refine_s8_(w.refine_s8, height / 8, width / 8, next_region(arena_)),
-      upsampler_(w, height / 8, width / 8, next_region(arena_)),
+      refine_s16_(w.refine_s16, height / 16, width / 16, next_region(context_)),
+      merge_(w, height / 8, width / 8, next_region(context_)),
+      refine_s8_(w.refine_s8, height / 8, width / 8, next_region(context_)),
+      upsampler_(w, height / 8, width / 8, next_region(context_)),
       context16_(height / 16, width / 16, kContext),
       flow8_(height / 8, width / 8, 2) {
-  arena_.finalize();
+  context_.arena.finalize();
 }
 
 void NetworkPlan::encode(dnnl::stream& stream, const Tensor& image, FrameFeatures& out) {

@@ -10,7 +10,7 @@
 #include "stages/global_matching.hpp"
 #include "stages/refinement.hpp"
 #include "stages/scale_merge.hpp"
-#include "dnnl/scratch_arena.hpp"
+#include "dnnl/plan_context.hpp"
 #include "tensor.hpp"
 #include "weights.hpp"
 
@@ -18,8 +18,9 @@ namespace neuflow::model {
 
 class NetworkPlan {
  public:
-  // height, width: multiples of 16, at least 32.
-  NetworkPlan(const NetworkWeights& weights, int height, int width);
+  // height, width: multiples of 16, at least 32. `convolution`: how the stride-1 3×3
+  // convolutions are computed (automatic, direct or winograd; never read from the environment here).
+  NetworkPlan(const NetworkWeights& weights, int height, int width, CpuConvolution convolution);
 
   int height() const { return height_; }
   int width() const { return width_; }
@@ -33,7 +34,7 @@ class NetworkPlan {
 
  private:
   int height_, width_;
-  ScratchArena arena_;  // declared before the stages, which take buffers from it
+  PlanContext context_;  // declared before the stages, which take buffers from its arena
   FrameEncoder encoder_;
   CrossAttention attention_;
   GlobalMatching matching_;

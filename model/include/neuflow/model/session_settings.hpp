@@ -22,6 +22,14 @@ enum class Backend { automatic, cpu, vulkan };
 // computes in fp32 either way.
 enum class Precision { fp32, fp16 };
 
+// How the CPU backend computes its stride-1 3×3 convolutions, most of the network's
+// arithmetic: `automatic` by Winograd F(4×4, 3×3) on the layers where that measured faster
+// than oneDNN's direct convolution, unless the environment's NEUFLOW_CONV (auto, direct or
+// winograd) says otherwise; `direct` by oneDNN everywhere (the reference path for tests and
+// benchmarks); `winograd` on every such layer. Winograd's results differ from direct ones by
+// rounding only (tests/model/winograd_conv_test.cpp states the bound).
+enum class CpuConvolution { automatic, direct, winograd };
+
 struct Iterations {
   int s16 = 1;  // refinement iterations at 1/16
   int s8 = 8;   // refinement iterations at 1/8
@@ -55,6 +63,7 @@ struct SessionOptions {
   // integrated GPU (for `vulkan` without one, the first device).
   int device = -1;
   Precision precision = Precision::fp32;
+  CpuConvolution cpu_convolution = CpuConvolution::automatic;
   bool operator==(const SessionOptions&) const = default;
 };
 
@@ -86,9 +95,14 @@ std::optional<ChannelOrder> parse_channel_order(std::string_view name);
 constexpr std::string_view backend_name(Backend backend) {
   return backend == Backend::cpu ? "cpu" : backend == Backend::vulkan ? "vulkan" : "auto";
 }
-std::optional<Backend> parse_backend(std::string_view name);
+std::optional<Backend> parse_backend(std::string_view name);  // "auto", "cpu", "vulkan"
 
 constexpr std::string_view precision_name(Precision precision) { return precision == Precision::fp16 ? "fp16" : "fp32"; }
-std::optional<Precision> parse_precision(std::string_view name);  // "fp32", "fp16"  // "auto", "cpu", "vulkan"
+std::optional<Precision> parse_precision(std::string_view name);  // "fp32", "fp16"
+
+constexpr std::string_view cpu_convolution_name(CpuConvolution c) {
+  return c == CpuConvolution::direct ? "direct" : c == CpuConvolution::winograd ? "winograd" : "auto";
+}
+std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name);  // "auto", "direct", "winograd"
 
 }  // namespace neuflow::model

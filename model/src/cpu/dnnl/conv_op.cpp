@@ -27,11 +27,24 @@ dnnl::primitive_attr make_attr(const ConvParams& p) {
   return attr;
 }
 
+// Where Winograd F(4×4, 3×3) measured faster than oneDNN's direct convolution on 2 Zen 3
+// cores (docs/benchmarks.md, "Winograd"): every stride-1 3×3 layer of the network with at
+// least this many input channels.
+constexpr int kWinogradMinInputChannels = 32;
+
+bool use_winograd(const ConvWeights& w, const ConvParams& p, CpuConvolution choice,
+                  const std::optional<memory::desc>& output, const memory::desc& blocked_output) {
+  if (choice == CpuConvolution::direct || !WinogradConv::handles(w, p)) return false;
+  if (output && *output != blocked_output) return false;
+  return choice == CpuConvolution::winograd || w.in_channels >= kWinogradMinInputChannels;
+}
+
 }  // namespace
 
-ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& input, ScratchArena& arena,
+ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& input, PlanContext& context,
                std::optional<memory::desc> output)
     : accumulate_(p.accumulate) {
+  ScratchArena& arena = context.arena;
   const auto& eng = cpu_engine();
   const auto dims = input.dims();  // {1, C, H, W}
   if (dims.size() != 4 || dims[1] != w.in_channels) {
@@ -42,6 +55,18 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
   out_c_ = w.out_channels;
   out_h_ = (in_h + 2 * p.pad - w.kernel_h) / p.stride + 1;
   out_w_ = (in_w + 2 * p.pad - w.kernel_w) / p.stride + 1;
+
+  const memory::desc blocked_output({1, out_c_, out_h_, out_w_}, dt::f32, tag::nChw8c);
+  if (use_winograd(w, p, context.convolution, output, blocked_output)) {
+    winograd_.emplace(w, p, in_h, in_w, arena);
+    dst_ = arena.make(blocked_output);
+    const memory::desc blocked_input({1, w.in_channels, in_h, in_w}, dt::f32, tag::nChw8c);
+    if (blocked_input != input) {
+      reordered_input_ = arena.make(blocked_input);
+      input_reorder_ = dnnl::reorder(dnnl::reorder::primitive_desc(eng, input, eng, blocked_input));
+    }
+    return;
+  }
 
   const memory::dims src_dims{1, w.in_channels, in_h, in_w};
   const memory::dims wei_dims{w.out_channels, w.in_channels, w.kernel_h, w.kernel_w};
@@ -82,6 +107,13 @@ const memory& ConvOp::run(dnnl::stream& stream, const memory& input, const memor
     memory in = input;  // a handle copy: reorder::execute takes non-const handles
     input_reorder_->execute(stream, in, reordered_input_);
     src = &reordered_input_;
+  }
+  if (winograd_) {
+    if (addend && addend->get_desc() != dst_.get_desc()) throw std::logic_error("ConvOp: addend layout differs");
+    winograd_->run(static_cast<const float*>(src->get_data_handle()),
+                   addend ? static_cast<const float*>(addend->get_data_handle()) : nullptr,
+                   static_cast<float*>(dst_.get_data_handle()));
+    return dst_;
   }
   if (addend) {
     std::memcpy(dst_.get_data_handle(), addend->get_data_handle(), dst_.get_desc().get_size());

@@ -1,34 +1,26 @@
 #pragma once
-// One convolution as a oneDNN primitive, created once per input size: weights reordered to
-// the layout the primitive wants, bias and activation fused, output buffer owned here.
+// One convolution, created once per input size: a oneDNN primitive (weights reordered to the
+// layout it wants, bias and activation fused), or for a stride-1 3×3 one where the plan says
+// so, Winograd F(4×4, 3×3) on oneDNN's 8-channel blocked layout. Output buffer owned here.
 #include <dnnl.hpp>
 
 #include <optional>
 
-#include "dnnl/scratch_arena.hpp"
+#include "dnnl/conv_params.hpp"
+#include "dnnl/plan_context.hpp"
 #include "tensor.hpp"
 #include "weights.hpp"
+#include "winograd/winograd_conv.hpp"
 
 namespace neuflow::model {
-
-enum class Activation { none, leaky_relu, relu, gelu };
-
-struct ConvParams {
-  int stride = 1;
-  int pad = 0;
-  Activation activation = Activation::none;
-  // Adds a tensor given at run time to the convolution's result before the activation.
-  // Used to add the per-pair constant part of the refinement's first convolution.
-  bool accumulate = false;
-};
 
 class ConvOp {
  public:
   // `input` describes the memory run() will receive: NHWC from a stage, or a previous
-  // ConvOp's output(). The output and any reordered input live in `arena` (current region).
-  // `output` forces the output layout (default: the primitive's choice).
+  // ConvOp's output(). The output and any reordered input live in the context's arena
+  // (current region). `output` forces the output layout (default: the primitive's choice).
   ConvOp(const ConvWeights& weights, const ConvParams& params, const dnnl::memory::desc& input,
-         ScratchArena& arena, std::optional<dnnl::memory::desc> output = std::nullopt);
+         PlanContext& context, std::optional<dnnl::memory::desc> output = std::nullopt);
 
   // Runs the convolution; `addend` (required iff params.accumulate) must have output_desc().
   const dnnl::memory& run(dnnl::stream& stream, const dnnl::memory& input,
@@ -43,10 +35,12 @@ class ConvOp {
   int out_h() const { return out_h_; }
   int out_w() const { return out_w_; }
   int out_channels() const { return out_c_; }
+  bool is_winograd() const { return winograd_.has_value(); }
 
  private:
   int out_h_ = 0, out_w_ = 0, out_c_ = 0;
   bool accumulate_ = false;
+  std::optional<WinogradConv> winograd_;
   dnnl::convolution_forward conv_;
   dnnl::memory weights_, bias_, dst_;
   std::optional<dnnl::reorder> input_reorder_;

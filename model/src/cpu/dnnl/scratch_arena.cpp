@@ -23,10 +23,16 @@ dnnl::memory ScratchArena::make(const dnnl::memory::desc& desc) {
 
 void ScratchArena::next_region() { region_end_ = 0; }
 
+void ScratchArena::reserve_workspace(std::size_t bytes) {
+  if (storage_) throw std::logic_error("ScratchArena: reserve_workspace() after finalize()");
+  workspace_size_ = std::max(workspace_size_, align_up(bytes));
+}
+
 void ScratchArena::finalize() {
-  storage_.reset(new std::byte[size_ + kAlignment]);
+  storage_.reset(new std::byte[size_ + workspace_size_ + kAlignment]);
   auto* base = reinterpret_cast<std::byte*>(align_up(reinterpret_cast<std::size_t>(storage_.get())));
   for (auto& b : bindings_) b.memory.set_data_handle(base + b.offset);
+  workspace_ = base + align_up(size_);
 }
 
 }  // namespace neuflow::model

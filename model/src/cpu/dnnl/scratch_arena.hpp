@@ -21,7 +21,12 @@ class ScratchArena {
   // Allocates the largest region's size once and binds every memory made so far.
   void finalize();
 
-  std::size_t size_bytes() const { return size_; }
+  // Room that one operation uses only while it runs (the Winograd convolutions' transformed
+  // tiles): operations run one at a time, so all share one block of the largest size asked.
+  void reserve_workspace(std::size_t bytes);
+  std::byte* workspace() const { return workspace_; }  // after finalize()
+
+  std::size_t size_bytes() const { return size_ + workspace_size_; }
 
  private:
   struct Binding {
@@ -31,6 +36,8 @@ class ScratchArena {
   std::vector<Binding> bindings_;
   std::size_t region_end_ = 0;
   std::size_t size_ = 0;
+  std::size_t workspace_size_ = 0;
+  std::byte* workspace_ = nullptr;
   std::unique_ptr<std::byte[]> storage_;
 };
 

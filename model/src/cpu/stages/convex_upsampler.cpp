@@ -14,13 +14,13 @@ constexpr int kFactor = 8;
 constexpr int kNeighbours = 9;
 }  // namespace
 
-ConvexUpsampler::ConvexUpsampler(const NetworkWeights& w, int h8, int w8, ScratchArena& arena)
+ConvexUpsampler::ConvexUpsampler(const NetworkWeights& w, int h8, int w8, PlanContext& context)
     : input_(h8, w8, 130) {
-  conv1_.emplace(w.upsample_conv1, ConvParams{1, 1, Activation::relu}, nhwc_desc(h8, w8, 130), arena);
-  conv2_.emplace(w.upsample_conv2, ConvParams{1, 1, Activation::relu}, conv1_->output_desc(), arena);
+  conv1_.emplace(w.upsample_conv1, ConvParams{1, 1, Activation::relu}, nhwc_desc(h8, w8, 130), context);
+  conv2_.emplace(w.upsample_conv2, ConvParams{1, 1, Activation::relu}, conv1_->output_desc(), context);
   // The mask in 8-channel blocks: channel k*64 + a*8 + b is block k*8 + a, lane b, so the
   // combination below reads it in place without a conversion to NHWC.
-  conv3_.emplace(w.upsample_conv3, ConvParams{1, 0, Activation::none}, conv2_->output_desc(), arena,
+  conv3_.emplace(w.upsample_conv3, ConvParams{1, 0, Activation::none}, conv2_->output_desc(), context,
                  dnnl::memory::desc({1, 576, h8, w8}, dnnl::memory::data_type::f32,
                                     dnnl::memory::format_tag::nChw8c));
 }

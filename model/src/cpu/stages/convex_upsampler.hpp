@@ -13,7 +13,7 @@ namespace neuflow::model {
 
 class ConvexUpsampler {
  public:
-  ConvexUpsampler(const NetworkWeights& weights, int h8, int w8, ScratchArena& arena);
+  ConvexUpsampler(const NetworkWeights& weights, int h8, int w8, PlanContext& context);
 
   // flow8 [h8, w8, 2], image_features [h8, w8, 128] (conv_s8 of frame 0) → flow [8·h8, 8·w8, 2].
   void run(dnnl::stream& stream, const Tensor& flow8, const Tensor& image_features, Tensor& flow);

@@ -17,19 +17,19 @@ void avg_pool_2x(const Tensor& src, Tensor& dst) {
 }
 
 dnnl::concat make_concat(const dnnl::memory::desc& a, const dnnl::memory::desc& b, dnnl::memory& dst,
-                         ScratchArena& arena) {
+                         PlanContext& context) {
   const dnnl::concat::primitive_desc pd(1, {a, b}, cpu_engine());
-  dst = arena.make(pd.dst_desc());
+  dst = context.arena.make(pd.dst_desc());
   return dnnl::concat(pd);
 }
 
 }  // namespace
 
 FrameEncoder::Block FrameEncoder::make_block(const ConvBlockWeights& w, int stride, int pad,
-                                             const dnnl::memory::desc& input, ScratchArena& arena) {
+                                             const dnnl::memory::desc& input, PlanContext& context) {
   Block b;
-  b.conv1.emplace(w.conv1, ConvParams{stride, pad, Activation::leaky_relu}, input, arena);
-  b.conv2.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, b.conv1->output_desc(), arena);
+  b.conv1.emplace(w.conv1, ConvParams{stride, pad, Activation::leaky_relu}, input, context);
+  b.conv2.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, b.conv1->output_desc(), context);
   return b;
 }
 
@@ -37,20 +37,20 @@ const dnnl::memory& FrameEncoder::run_block(dnnl::stream& stream, Block& b, cons
   return b.conv2->run(stream, b.conv1->run(stream, input));
 }
 
-FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, ScratchArena& arena)
+FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, PlanContext& context)
     : height_(height), width_(width) {
   half_.resize(height / 2, width / 2, 3);
   quarter_.resize(height / 4, width / 4, 3);
   eighth_.resize(height / 8, width / 8, 3);
-  block_8_1_ = make_block(w.block_8_1, 4, 2, nhwc_desc(height / 2, width / 2, 3), arena);
-  block_8_2_ = make_block(w.block_8_2, 2, 2, nhwc_desc(height / 4, width / 4, 3), arena);
-  concat_8_ = make_concat(block_8_1_.conv2->output_desc(), block_8_2_.conv2->output_desc(), cat8_, arena);
-  block_cat_8_ = make_block(w.block_cat_8, 1, 1, cat8_.get_desc(), arena);
-  block_16_1_ = make_block(w.block_16_1, 2, 2, nhwc_desc(height / 8, width / 8, 3), arena);
-  block_8_16_ = make_block(w.block_8_16, 2, 2, block_cat_8_.conv2->output_desc(), arena);
-  concat_16_ = make_concat(block_16_1_.conv2->output_desc(), block_8_16_.conv2->output_desc(), cat16_, arena);
-  block_cat_16_ = make_block(w.block_cat_16, 1, 1, cat16_.get_desc(), arena);
-  conv_s8_ = make_block(w.conv_s8, 8, 0, nhwc_desc(height, width, 3), arena);
+  block_8_1_ = make_block(w.block_8_1, 4, 2, nhwc_desc(height / 2, width / 2, 3), context);
+  block_8_2_ = make_block(w.block_8_2, 2, 2, nhwc_desc(height / 4, width / 4, 3), context);
+  concat_8_ = make_concat(block_8_1_.conv2->output_desc(), block_8_2_.conv2->output_desc(), cat8_, context);
+  block_cat_8_ = make_block(w.block_cat_8, 1, 1, cat8_.get_desc(), context);
+  block_16_1_ = make_block(w.block_16_1, 2, 2, nhwc_desc(height / 8, width / 8, 3), context);
+  block_8_16_ = make_block(w.block_8_16, 2, 2, block_cat_8_.conv2->output_desc(), context);
+  concat_16_ = make_concat(block_16_1_.conv2->output_desc(), block_8_16_.conv2->output_desc(), cat16_, context);
+  block_cat_16_ = make_block(w.block_cat_16, 1, 1, cat16_.get_desc(), context);
+  conv_s8_ = make_block(w.conv_s8, 8, 0, nhwc_desc(height, width, 3), context);
 }
 
 void FrameEncoder::run(dnnl::stream& stream, const Tensor& image, FrameFeatures& out) {

@@ -21,7 +21,7 @@ struct FrameFeatures {
 class FrameEncoder {
  public:
   // height and width: the model resolution, multiples of 16.
-  FrameEncoder(const NetworkWeights& weights, int height, int width, ScratchArena& arena);
+  FrameEncoder(const NetworkWeights& weights, int height, int width, PlanContext& context);
 
   // image: [height, width, 3], RGB scaled to 0..1.
   void run(dnnl::stream& stream, const Tensor& image, FrameFeatures& out);
@@ -31,7 +31,7 @@ class FrameEncoder {
     std::optional<ConvOp> conv1, conv2;
   };
   Block make_block(const ConvBlockWeights& w, int stride, int pad, const dnnl::memory::desc& input,
-                   ScratchArena& arena);
+                   PlanContext& context);
   const dnnl::memory& run_block(dnnl::stream& stream, Block& b, const dnnl::memory& input);
 
   int height_, width_;

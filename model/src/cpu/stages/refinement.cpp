@@ -13,21 +13,21 @@ constexpr int kFlowOffset = kCorrChannels + kHiddenChannels;
 constexpr float kHiddenClamp = 4.f;
 }  // namespace
 
-Refinement::Refinement(const RefineWeights& w, int h, int width, ScratchArena& arena)
+Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& context)
     : input_(h, width, kRefineDynamicChannels),
       constant_(h, width, kRefineConstantChannels),
       hidden_(h, width, kHiddenChannels),
       delta_(h, width, 2) {
-  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c), arena);
-  conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), arena,
+  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c), context);
+  conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), context,
                           conv1_->output_desc());
-  conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, conv1_->output_desc(), arena);
+  conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, conv1_->output_desc(), context);
   const ConvOp* prev = &*conv2_;
   for (std::size_t i = 0; i < layers_.size(); ++i) {
-    layers_[i].emplace(w.conv_layers[i], ConvParams{1, 1, Activation::leaky_relu}, prev->output_desc(), arena);
+    layers_[i].emplace(w.conv_layers[i], ConvParams{1, 1, Activation::leaky_relu}, prev->output_desc(), context);
     prev = &*layers_[i];
   }
-  conv3_.emplace(w.conv3, ConvParams{1, 1, Activation::none}, prev->output_desc(), arena);
+  conv3_.emplace(w.conv3, ConvParams{1, 1, Activation::none}, prev->output_desc(), context);
 }
 
 void Refinement::begin(dnnl::stream& stream, const Tensor& context) {

@@ -16,7 +16,7 @@ namespace neuflow::model {
 
 class Refinement {
  public:
-  Refinement(const RefineWeights& weights, int h, int w, ScratchArena& arena);
+  Refinement(const RefineWeights& weights, int h, int w, PlanContext& context);
 
   // Starts a pair: context [h, w, 64]; hidden state reset to zero.
   void begin(dnnl::stream& stream, const Tensor& context);

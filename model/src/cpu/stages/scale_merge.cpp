@@ -4,12 +4,12 @@
 
 namespace neuflow::model {
 
-ScaleMerge::ScaleMerge(const NetworkWeights& w, int h8, int w8, ScratchArena& arena)
+ScaleMerge::ScaleMerge(const NetworkWeights& w, int h8, int w8, PlanContext& context)
     : feature_input_(h8, w8, 256), context_input_(h8, w8, 128) {
-  merge0_.emplace(w.merge_s8_0, ConvParams{1, 1, Activation::gelu}, nhwc_desc(h8, w8, 256), arena);
-  merge2_.emplace(w.merge_s8_2, ConvParams{1, 1, Activation::none}, merge0_->output_desc(), arena);
-  context0_.emplace(w.context_merge_s8_0, ConvParams{1, 1, Activation::gelu}, nhwc_desc(h8, w8, 128), arena);
-  context2_.emplace(w.context_merge_s8_2, ConvParams{1, 1, Activation::none}, context0_->output_desc(), arena);
+  merge0_.emplace(w.merge_s8_0, ConvParams{1, 1, Activation::gelu}, nhwc_desc(h8, w8, 256), context);
+  merge2_.emplace(w.merge_s8_2, ConvParams{1, 1, Activation::none}, merge0_->output_desc(), context);
+  context0_.emplace(w.context_merge_s8_0, ConvParams{1, 1, Activation::gelu}, nhwc_desc(h8, w8, 128), context);
+  context2_.emplace(w.context_merge_s8_2, ConvParams{1, 1, Activation::none}, context0_->output_desc(), context);
 }
 
 void ScaleMerge::merge_features(dnnl::stream& stream, const ChannelSlice& feature8, const ChannelSlice& feature16,

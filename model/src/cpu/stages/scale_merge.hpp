@@ -13,7 +13,7 @@ namespace neuflow::model {
 
 class ScaleMerge {
  public:
-  ScaleMerge(const NetworkWeights& weights, int h8, int w8, ScratchArena& arena);
+  ScaleMerge(const NetworkWeights& weights, int h8, int w8, PlanContext& context);
 
   // merge_s8(concat[feature8, up2x(feature16)]) → out [h8, w8, 128].
   void merge_features(dnnl::stream& stream, const ChannelSlice& feature8, const ChannelSlice& feature16, Tensor& out);

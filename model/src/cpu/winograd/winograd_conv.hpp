@@ -1,0 +1,51 @@
+#pragma once
+// A stride-1, pad-1 3×3 convolution by Winograd F(4×4, 3×3) on oneDNN's 8-channel blocked
+// layout (nChw8c), for one input size. The filters are transformed once here. run() splits
+// the output's 4×4 tiles into blocks, one thread a block: each block's inputs are transformed
+// (Bᵀ d B), multiplied by the filters point by point (36 products of tiles × channels), and
+// transformed back (Aᵀ m A) with bias, addend and activation applied on the way out, so a
+// block's intermediate data stays in the core's cache.
+#include <cstddef>
+#include <vector>
+
+#include "dnnl/conv_params.hpp"
+#include "dnnl/scratch_arena.hpp"
+#include "weights.hpp"
+
+namespace neuflow::model {
+
+class WinogradConv {
+ public:
+  // True when these weights and parameters are a convolution this class computes.
+  static bool handles(const ConvWeights& weights, const ConvParams& params);
+
+  WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width, ScratchArena& arena);
+
+  // input: [C/8][H][W][8]; addend (iff params.accumulate) and output: [K/8][H][W][8], the
+  // padding channels of the output written as zeros.
+  void run(const float* input, const float* addend, float* output) const;
+
+  int tiles() const { return tiles_; }
+  int tiles_per_block() const { return block_tiles_; }
+
+ private:
+  void transform_inputs(const float* input, int first_tile, int count, float* points) const;
+  void transform_outputs(const float* products, int first_tile, int count, const float* addend, float* output) const;
+
+  int height_, width_;
+  int in_channels_;      // padded to 8
+  int out_channels_;     // padded to 8: what the output holds
+  int gemm_columns_;     // padded to 16: the products' width
+  Activation activation_;
+  bool accumulate_;
+  int tiles_x_, tiles_;
+  int block_tiles_;      // a multiple of the GEMM's rows
+  int blocks_;
+  int threads_;
+  std::size_t thread_floats_;  // workspace floats each thread uses
+  const ScratchArena* arena_;
+  std::vector<float> filters_;  // [36][columns / 16][in_channels][16]
+  std::vector<float> bias_;     // gemm_columns_ values
+};
+
+}  // namespace neuflow::model
