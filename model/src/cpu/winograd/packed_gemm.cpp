@@ -1,89 +1,134 @@
 #include "winograd/packed_gemm.hpp"
 
-#if defined(__AVX2__) && defined(__FMA__)
+#if defined(__x86_64__)
 #include <immintrin.h>
-#else
-#include "winograd/float8.hpp"
 #endif
+
+#include "winograd/float8.hpp"
 
 namespace neuflow::model::winograd {
 
 namespace {
 
-#if defined(__AVX2__) && defined(__FMA__)
-
-// 6 rows × 16 columns held in 12 registers over the whole depth: per step two panel loads,
-// six broadcasts and twelve FMAs, so the FMA units, not the loads, set the pace.
-void kernel_6x16(const float* a, int depth, const float* b, float* c, int ldc) {
-  __m256 acc[kGemmRows][2];
-  for (auto& row : acc) row[0] = row[1] = _mm256_setzero_ps();
-  const float* a0 = a;
-  const float* a1 = a + depth;
-  const float* a2 = a + 2 * depth;
-  const float* a3 = a + 3 * depth;
-  const float* a4 = a + 4 * depth;
-  const float* a5 = a + 5 * depth;
-  for (int k = 0; k < depth; ++k) {
-    const __m256 b0 = _mm256_loadu_ps(b + kGemmPanel * k);
-    const __m256 b1 = _mm256_loadu_ps(b + kGemmPanel * k + 8);
-    __m256 x = _mm256_broadcast_ss(a0 + k);
-    acc[0][0] = _mm256_fmadd_ps(x, b0, acc[0][0]);
-    acc[0][1] = _mm256_fmadd_ps(x, b1, acc[0][1]);
-    x = _mm256_broadcast_ss(a1 + k);
-    acc[1][0] = _mm256_fmadd_ps(x, b0, acc[1][0]);
-    acc[1][1] = _mm256_fmadd_ps(x, b1, acc[1][1]);
-    x = _mm256_broadcast_ss(a2 + k);
-    acc[2][0] = _mm256_fmadd_ps(x, b0, acc[2][0]);
-    acc[2][1] = _mm256_fmadd_ps(x, b1, acc[2][1]);
-    x = _mm256_broadcast_ss(a3 + k);
-    acc[3][0] = _mm256_fmadd_ps(x, b0, acc[3][0]);
-    acc[3][1] = _mm256_fmadd_ps(x, b1, acc[3][1]);
-    x = _mm256_broadcast_ss(a4 + k);
-    acc[4][0] = _mm256_fmadd_ps(x, b0, acc[4][0]);
-    acc[4][1] = _mm256_fmadd_ps(x, b1, acc[4][1]);
-    x = _mm256_broadcast_ss(a5 + k);
-    acc[5][0] = _mm256_fmadd_ps(x, b0, acc[5][0]);
-    acc[5][1] = _mm256_fmadd_ps(x, b1, acc[5][1]);
-  }
-  for (int r = 0; r < kGemmRows; ++r) {
-    _mm256_storeu_ps(c + r * ldc, acc[r][0]);
-    _mm256_storeu_ps(c + r * ldc + 8, acc[r][1]);
+// Panels outside, so one panel of B (depth × panel floats) stays in L1 while the rows pass.
+template <int Rows, int Panel, void (*Kernel)(const float*, int, const float*, float*, int)>
+void panels(const float* a, const float* b_packed, float* c, int rows, int depth, int columns) {
+  for (int p = 0; p < columns / Panel; ++p) {
+    const float* b = b_packed + static_cast<long>(p) * depth * Panel;
+    for (int r = 0; r < rows; r += Rows) {
+      Kernel(a + static_cast<long>(r) * depth, depth, b, c + static_cast<long>(r) * columns + p * Panel, columns);
+    }
   }
 }
 
-#else
-
-// The same kernel for targets without AVX2/FMA, in the portable eight-float type.
-void kernel_6x16(const float* a, int depth, const float* b, float* c, int ldc) {
-  Float8 acc[kGemmRows][2] = {};
+// Portable: 6 rows × 16 columns in Float8 (the compiler's vector code for the target).
+void kernel_portable(const float* a, int depth, const float* b, float* c, int ldc) {
+  Float8 acc[6][2] = {};
   for (int k = 0; k < depth; ++k) {
-    const Float8 b0 = load8(b + kGemmPanel * k);
-    const Float8 b1 = load8(b + kGemmPanel * k + 8);
-    for (int r = 0; r < kGemmRows; ++r) {
+    const Float8 b0 = load8(b + 16 * k);
+    const Float8 b1 = load8(b + 16 * k + 8);
+    for (int r = 0; r < 6; ++r) {
       const Float8 x = splat8(a[r * depth + k]);
       acc[r][0] += x * b0;
       acc[r][1] += x * b1;
     }
   }
-  for (int r = 0; r < kGemmRows; ++r) {
+  for (int r = 0; r < 6; ++r) {
     store8(c + r * ldc, acc[r][0]);
     store8(c + r * ldc + 8, acc[r][1]);
   }
 }
 
+#if defined(__x86_64__)
+
+// The accumulators are named variables, not an array, so the compiler keeps every one in a
+// register across the depth loop (an array was spilled to the stack at each step).
+#define NEUFLOW_ROW_AVX2(r)                              \
+  {                                                      \
+    const __m256 x = _mm256_broadcast_ss(a + (r) * depth + k); \
+    c##r##0 = _mm256_fmadd_ps(x, b0, c##r##0);           \
+    c##r##1 = _mm256_fmadd_ps(x, b1, c##r##1);           \
+  }
+#define NEUFLOW_STORE_AVX2(r)                          \
+  _mm256_storeu_ps(c + (r) * ldc, c##r##0);            \
+  _mm256_storeu_ps(c + (r) * ldc + 8, c##r##1);
+
+// AVX2/FMA: 6 rows × 16 columns in 12 registers; per step two panel loads, six broadcasts and
+// twelve FMAs, so the FMA units set the pace.
+__attribute__((target("avx2,fma"))) void kernel_avx2(const float* a, int depth, const float* b, float* c, int ldc) {
+  __m256 c00 = _mm256_setzero_ps(), c01 = c00, c10 = c00, c11 = c00, c20 = c00, c21 = c00, c30 = c00, c31 = c00,
+         c40 = c00, c41 = c00, c50 = c00, c51 = c00;
+  for (int k = 0; k < depth; ++k) {
+    const __m256 b0 = _mm256_loadu_ps(b + 16 * k);
+    const __m256 b1 = _mm256_loadu_ps(b + 16 * k + 8);
+    NEUFLOW_ROW_AVX2(0) NEUFLOW_ROW_AVX2(1) NEUFLOW_ROW_AVX2(2) NEUFLOW_ROW_AVX2(3) NEUFLOW_ROW_AVX2(4)
+    NEUFLOW_ROW_AVX2(5)
+  }
+  NEUFLOW_STORE_AVX2(0) NEUFLOW_STORE_AVX2(1) NEUFLOW_STORE_AVX2(2) NEUFLOW_STORE_AVX2(3) NEUFLOW_STORE_AVX2(4)
+  NEUFLOW_STORE_AVX2(5)
+}
+
+#define NEUFLOW_ROW_AVX512(r)                       \
+  {                                                 \
+    const __m512 x = _mm512_set1_ps(a[(r) * depth + k]); \
+    c##r##0 = _mm512_fmadd_ps(x, b0, c##r##0);      \
+    c##r##1 = _mm512_fmadd_ps(x, b1, c##r##1);      \
+  }
+#define NEUFLOW_STORE_AVX512(r)                     \
+  _mm512_storeu_ps(c + (r) * ldc, c##r##0);         \
+  _mm512_storeu_ps(c + (r) * ldc + 16, c##r##1);
+
+// AVX-512: 8 rows × 32 columns in 16 of the 32 registers; per step two panel loads, eight
+// broadcasts (folded into the FMAs) and sixteen FMAs.
+__attribute__((target("avx512f"))) void kernel_avx512(const float* a, int depth, const float* b, float* c, int ldc) {
+  __m512 c00 = _mm512_setzero_ps(), c01 = c00, c10 = c00, c11 = c00, c20 = c00, c21 = c00, c30 = c00, c31 = c00,
+         c40 = c00, c41 = c00, c50 = c00, c51 = c00, c60 = c00, c61 = c00, c70 = c00, c71 = c00;
+  for (int k = 0; k < depth; ++k) {
+    const __m512 b0 = _mm512_loadu_ps(b + 32 * k);
+    const __m512 b1 = _mm512_loadu_ps(b + 32 * k + 16);
+    NEUFLOW_ROW_AVX512(0) NEUFLOW_ROW_AVX512(1) NEUFLOW_ROW_AVX512(2) NEUFLOW_ROW_AVX512(3)
+    NEUFLOW_ROW_AVX512(4) NEUFLOW_ROW_AVX512(5) NEUFLOW_ROW_AVX512(6) NEUFLOW_ROW_AVX512(7)
+  }
+  NEUFLOW_STORE_AVX512(0) NEUFLOW_STORE_AVX512(1) NEUFLOW_STORE_AVX512(2) NEUFLOW_STORE_AVX512(3)
+  NEUFLOW_STORE_AVX512(4) NEUFLOW_STORE_AVX512(5) NEUFLOW_STORE_AVX512(6) NEUFLOW_STORE_AVX512(7)
+}
+
+#undef NEUFLOW_ROW_AVX2
+#undef NEUFLOW_STORE_AVX2
+#undef NEUFLOW_ROW_AVX512
+#undef NEUFLOW_STORE_AVX512
+
+constexpr GemmKernel kAvx2{"avx2", 6, 16, panels<6, 16, kernel_avx2>};
+constexpr GemmKernel kAvx512{"avx512", 8, 32, panels<8, 32, kernel_avx512>};
+
 #endif
+
+constexpr GemmKernel kPortable{"portable", 6, 16, panels<6, 16, kernel_portable>};
+
+struct Available {
+  const GemmKernel* kernels[3];
+  int count = 0;
+  Available() {
+#if defined(__x86_64__)
+    if (__builtin_cpu_supports("avx512f")) kernels[count++] = &kAvx512;
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) kernels[count++] = &kAvx2;
+#endif
+    kernels[count++] = &kPortable;
+  }
+};
+
+const Available& available() {
+  static const Available a;
+  return a;
+}
 
 }  // namespace
 
-void packed_gemm(const float* a, const float* b_packed, float* c, int rows, int depth, int columns) {
-  // Panels outside, so one panel of B (depth × 16 floats) stays in L1 while the rows pass.
-  for (int panel = 0; panel < columns / kGemmPanel; ++panel) {
-    const float* b = b_packed + static_cast<long>(panel) * depth * kGemmPanel;
-    for (int r = 0; r < rows; r += kGemmRows) {
-      kernel_6x16(a + static_cast<long>(r) * depth, depth, b, c + static_cast<long>(r) * columns + panel * kGemmPanel,
-                  columns);
-    }
-  }
+const GemmKernel& gemm_kernel() { return *available().kernels[0]; }
+
+const GemmKernel* const* gemm_kernels(int& count) {
+  count = available().count;
+  return available().kernels;
 }
 
 }  // namespace neuflow::model::winograd

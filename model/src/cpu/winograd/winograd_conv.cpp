@@ -19,12 +19,23 @@ namespace {
 constexpr int kLanes = 8;  // channels per block of the nChw8c layout
 
 int round_up(int v, int m) { return (v + m - 1) / m * m; }
+
+// The floats between consecutive points of a block's inputs or products: the 36 points of a
+// tile are read (or written) together, and at a stride that is a multiple of 4 KiB they would
+// all fall into the same L1 set and evict one another; one cache line more spreads them.
+std::size_t point_stride_for(int tiles, int channels) {
+  constexpr int kPage = 1024, kLine = 16;  // floats
+  return static_cast<std::size_t>(round_up(tiles * channels, kPage) + kLine);
+}
 int divide_up(int v, int m) { return (v + m - 1) / m; }
 
-// The transformed inputs of one block should stay in the core's L2 (512 KiB on Zen 3) while
-// the 36 products read them, with room for the filters' panels and the products.
-constexpr std::size_t kBlockInputBytes = 256 * 1024;
-constexpr int kMaxBlockTiles = 96;
+// A block's tiles: one point's transformed inputs (tiles × channels) stay in the core's L2
+// (at least 512 KiB on the x86 cores we measure) while its product passes over them once per
+// panel of output channels, and a thread's whole workspace (36 points of inputs and
+// products) stays within a share of L3. Larger blocks read the filters fewer times.
+constexpr std::size_t kPointInputBytes = 256 * 1024;
+constexpr std::size_t kThreadWorkspaceBytes = 16 * 1024 * 1024;
+constexpr int kMaxBlockTiles = 480;
 
 Float8 activate(Float8 v, Activation a) {
   switch (a) {
@@ -49,7 +60,8 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
       width_(width),
       in_channels_(round_up(w.in_channels, kLanes)),
       out_channels_(round_up(w.out_channels, kLanes)),
-      gemm_columns_(round_up(w.out_channels, kGemmPanel)),
+      kernel_(&gemm_kernel()),
+      gemm_columns_(round_up(w.out_channels, kernel_->panel)),
       activation_(p.activation),
       accumulate_(p.accumulate),
       tiles_x_(divide_up(width, kOutputTile)),
@@ -60,24 +72,30 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
   // Blocks of tiles: as many tiles as keep a block's inputs in L2, and a multiple of the
   // thread count of blocks so no thread waits for another's last block.
   threads_ = std::max(1, omp_get_max_threads());
-  const auto fit = static_cast<int>(kBlockInputBytes / (sizeof(float) * kPoints * in_channels_));
-  const int most = std::clamp(fit / kGemmRows * kGemmRows, kGemmRows, kMaxBlockTiles);
+  const auto fit_point = static_cast<int>(kPointInputBytes / (sizeof(float) * in_channels_));
+  const auto fit_thread =
+      static_cast<int>(kThreadWorkspaceBytes / (sizeof(float) * kPoints * (in_channels_ + gemm_columns_)));
+  const int rows = kernel_->rows;
+  const int most = std::clamp(std::min(fit_point, fit_thread) / rows * rows, rows, kMaxBlockTiles);
   blocks_ = round_up(divide_up(tiles_, most), threads_);
-  block_tiles_ = round_up(divide_up(tiles_, blocks_), kGemmRows);
+  block_tiles_ = round_up(divide_up(tiles_, blocks_), rows);
   blocks_ = divide_up(tiles_, block_tiles_);
-  thread_floats_ = static_cast<std::size_t>(kPoints) * block_tiles_ * (in_channels_ + gemm_columns_);
+  input_stride_ = point_stride_for(block_tiles_, in_channels_);
+  product_stride_ = point_stride_for(block_tiles_, gemm_columns_);
+  thread_floats_ = kPoints * (input_stride_ + product_stride_);
   arena.reserve_workspace(sizeof(float) * thread_floats_ * static_cast<std::size_t>(threads_));
 
   // Filters: G g Gᵀ for every (output, input) pair, packed as the GEMM reads them.
-  const int panels = gemm_columns_ / kGemmPanel;
+  const int panel = kernel_->panel;
+  const int panels = gemm_columns_ / panel;
   filters_.assign(static_cast<std::size_t>(kPoints) * gemm_columns_ * in_channels_, 0.f);
   float points[kPoints];
   for (int o = 0; o < w.out_channels; ++o) {
     for (int c = 0; c < w.in_channels; ++c) {
       transform_filter(w.weight.data() + (static_cast<std::size_t>(o) * w.in_channels + c) * 9, points);
       for (int xi = 0; xi < kPoints; ++xi) {
-        const std::size_t panel = static_cast<std::size_t>(xi) * panels + o / kGemmPanel;
-        filters_[(panel * in_channels_ + c) * kGemmPanel + o % kGemmPanel] = points[xi];
+        const std::size_t at = static_cast<std::size_t>(xi) * panels + o / panel;
+        filters_[(at * in_channels_ + c) * panel + o % panel] = points[xi];
       }
     }
   }
@@ -86,7 +104,7 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
 }
 
 void WinogradConv::transform_inputs(const float* input, int first, int count, float* points) const {
-  const std::size_t point_stride = static_cast<std::size_t>(block_tiles_) * in_channels_;
+  const std::size_t point_stride = input_stride_;
   const std::size_t plane = static_cast<std::size_t>(height_) * width_ * kLanes;
   Float8 d[kPoints], v[kPoints];
   for (int t = 0; t < count; ++t) {
@@ -110,7 +128,7 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
     }
   }
   // The GEMM takes whole groups of rows: tiles past the image's last one are zeros.
-  for (int t = count; t < round_up(count, kGemmRows); ++t) {
+  for (int t = count; t < round_up(count, kernel_->rows); ++t) {
     for (int xi = 0; xi < kPoints; ++xi) {
       std::fill_n(points + xi * point_stride + static_cast<std::size_t>(t) * in_channels_, in_channels_, 0.f);
     }
@@ -119,7 +137,7 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
 
 void WinogradConv::transform_outputs(const float* products, int first, int count, const float* addend,
                                      float* output) const {
-  const std::size_t point_stride = static_cast<std::size_t>(block_tiles_) * gemm_columns_;
+  const std::size_t point_stride = product_stride_;
   const std::size_t plane = static_cast<std::size_t>(height_) * width_ * kLanes;
   Float8 m[kPoints], o[kOutputTile * kOutputTile];
   for (int t = 0; t < count; ++t) {
@@ -149,21 +167,20 @@ void WinogradConv::run(const float* input, const float* addend, float* output) c
   if (accumulate_ != (addend != nullptr)) throw std::logic_error("WinogradConv: addend given iff accumulate");
   auto* workspace = reinterpret_cast<float*>(arena_->workspace());
   const int threads = std::min(threads_, std::max(1, omp_get_max_threads()));
-  const std::size_t gemm_rows_stride = static_cast<std::size_t>(block_tiles_);
 #pragma omp parallel num_threads(threads)
   {
     float* points = workspace + static_cast<std::size_t>(omp_get_thread_num()) * thread_floats_;
-    float* products = points + kPoints * gemm_rows_stride * in_channels_;
+    float* products = points + kPoints * input_stride_;
 #pragma omp for schedule(static)
     for (int b = 0; b < blocks_; ++b) {
       const int first = b * block_tiles_;
       const int count = std::min(block_tiles_, tiles_ - first);
-      const int rows = round_up(count, kGemmRows);
+      const int rows = round_up(count, kernel_->rows);
       transform_inputs(input, first, count, points);
       for (int xi = 0; xi < kPoints; ++xi) {
-        packed_gemm(points + xi * gemm_rows_stride * in_channels_,
+        kernel_->run(points + xi * input_stride_,
                     filters_.data() + static_cast<std::size_t>(xi) * gemm_columns_ * in_channels_,
-                    products + xi * gemm_rows_stride * gemm_columns_, rows, in_channels_, gemm_columns_);
+                     products + xi * product_stride_, rows, in_channels_, gemm_columns_);
       }
       transform_outputs(products, first, count, addend, output);
     }

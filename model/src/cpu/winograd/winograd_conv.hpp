@@ -11,6 +11,7 @@
 #include "dnnl/conv_params.hpp"
 #include "dnnl/scratch_arena.hpp"
 #include "weights.hpp"
+#include "winograd/packed_gemm.hpp"
 
 namespace neuflow::model {
 
@@ -35,16 +36,18 @@ class WinogradConv {
   int height_, width_;
   int in_channels_;      // padded to 8
   int out_channels_;     // padded to 8: what the output holds
-  int gemm_columns_;     // padded to 16: the products' width
+  const winograd::GemmKernel* kernel_;
+  int gemm_columns_;     // padded to the kernel's panel: the products' width
   Activation activation_;
   bool accumulate_;
   int tiles_x_, tiles_;
-  int block_tiles_;      // a multiple of the GEMM's rows
+  int block_tiles_;      // a multiple of the kernel's rows
   int blocks_;
   int threads_;
-  std::size_t thread_floats_;  // workspace floats each thread uses
+  std::size_t input_stride_, product_stride_;  // floats from one point to the next in a block
+  std::size_t thread_floats_;                  // workspace floats each thread uses
   const ScratchArena* arena_;
-  std::vector<float> filters_;  // [36][columns / 16][in_channels][16]
+  std::vector<float> filters_;  // [36][columns / panel][in_channels][panel]
   std::vector<float> bias_;     // gemm_columns_ values
 };
 

@@ -1,0 +1,130 @@
+// Winograd F(4×4, 3×3) against oneDNN's direct convolution at every stride-1 3×3 layer of
+// NeuFlow-V2, at the shapes a 768×432 model size gives them (1/16 is 27 rows: tiles cut by
+// the border), on random data; and each product kernel this CPU runs against the portable one.
+//
+// The bound: the largest difference from the direct result is at most 1e-5 of the sum of
+// |weight × input| over the output's receptive field (the scale of what rounding either way
+// can change); measured at 1.6e-6 to 3.3e-6 of it on these layers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "dnnl/context.hpp"
+#include "dnnl/conv_op.hpp"
+#include "neuflow/model/architecture.hpp"
+#include "winograd/packed_gemm.hpp"
+
+namespace neuflow::model {
+namespace {
+
+using tag = dnnl::memory::format_tag;
+
+struct LayerShape {
+  std::string name;
+  int in, out, scale;
+};
+
+std::vector<LayerShape> stride1_3x3_layers() {
+  std::vector<LayerShape> layers;
+  for (const auto& l : neuflow_v2_layers()) {
+    if (l.kind == LayerKind::conv && l.kernel == 3) layers.push_back({l.name, l.in, l.out, l.scale});
+  }
+  // The refinements' first convolution runs split: per-iteration inputs and per-pair constants.
+  for (const int scale : {8, 16}) {
+    layers.push_back({"refine_s" + std::to_string(scale) + ".conv1 per iteration", 147, 128, scale});
+    layers.push_back({"refine_s" + std::to_string(scale) + ".conv1 per pair", 65, 128, scale});
+  }
+  return layers;
+}
+
+// Runs one convolution on an NHWC input and returns its NHWC output.
+Tensor convolve(const ConvWeights& w, const Tensor& input, CpuConvolution choice, bool& used_winograd) {
+  PlanContext context{{}, choice};
+  ConvOp op(w, {1, 1, Activation::none}, nhwc_desc(input.h, input.w, input.c), context);
+  context.arena.finalize();
+  used_winograd = op.is_winograd();
+  dnnl::stream stream(cpu_engine());
+  Tensor in = input, out;
+  op.run_to_nhwc(stream, wrap_nhwc(in), out);
+  stream.wait();
+  return out;
+}
+
+TEST(WinogradConv, MatchesDirectAtEveryNetworkLayer) {
+  constexpr int kWidth = 768, kHeight = 432;
+  std::mt19937 rng(7);
+  std::normal_distribution<float> normal(0.f, 1.f);
+  for (const auto& layer : stride1_3x3_layers()) {
+    SCOPED_TRACE(layer.name);
+    const int h = kHeight / layer.scale, w = kWidth / layer.scale;
+    ConvWeights weights{layer.out, layer.in, 3, 3, std::vector<float>(static_cast<std::size_t>(layer.out) * layer.in * 9),
+                        std::vector<float>(static_cast<std::size_t>(layer.out))};
+    const float scale = 1.f / std::sqrt(9.f * layer.in);
+    for (auto& v : weights.weight) v = scale * normal(rng);
+    for (auto& v : weights.bias) v = 0.1f * normal(rng);
+    Tensor input(h, w, layer.in);
+    for (auto& v : input.data) v = normal(rng);
+
+    bool direct_winograd = true, winograd_winograd = false;
+    const Tensor direct = convolve(weights, input, CpuConvolution::direct, direct_winograd);
+    const Tensor winograd = convolve(weights, input, CpuConvolution::winograd, winograd_winograd);
+    ASSERT_FALSE(direct_winograd);
+    ASSERT_TRUE(winograd_winograd);
+    ASSERT_EQ(winograd.data.size(), direct.data.size());
+
+    // The receptive field's |weight × input| sum at every output: the direct convolution of
+    // |weights| over |input|, plus |bias|.
+    ConvWeights magnitude_weights = weights;
+    for (auto& v : magnitude_weights.weight) v = std::fabs(v);
+    for (auto& v : magnitude_weights.bias) v = std::fabs(v);
+    Tensor magnitude_input = input;
+    for (auto& v : magnitude_input.data) v = std::fabs(v);
+    bool unused = false;
+    const Tensor magnitude = convolve(magnitude_weights, magnitude_input, CpuConvolution::direct, unused);
+    double worst = 0;
+    for (std::size_t i = 0; i < direct.data.size(); ++i) {
+      worst = std::max(worst, std::fabs(static_cast<double>(winograd.data[i]) - direct.data[i]) / magnitude.data[i]);
+    }
+    EXPECT_LE(worst, 1e-5) << "largest difference relative to the receptive field's magnitude";
+    RecordProperty(layer.name, std::to_string(worst));
+  }
+}
+
+TEST(WinogradGemm, EveryKernelMatchesThePortableOne) {
+  int count = 0;
+  const winograd::GemmKernel* const* kernels = winograd::gemm_kernels(count);
+  ASSERT_GE(count, 1);
+  const winograd::GemmKernel& portable = *kernels[count - 1];
+  ASSERT_STREQ(portable.name, "portable");
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1.f, 1.f);
+  constexpr int kDepth = 152, kColumns = 96, kRows = 48;  // multiples of every kernel's rows and panel
+  std::vector<float> a(static_cast<std::size_t>(kRows) * kDepth), b(static_cast<std::size_t>(kDepth) * kColumns);
+  for (auto& v : a) v = u(rng);
+  for (auto& v : b) v = u(rng);
+  // The reference in plain row-major B: C[r][j] = Σ_k A[r][k] B[k][j].
+  std::vector<double> expected(static_cast<std::size_t>(kRows) * kColumns, 0.0);
+  for (int r = 0; r < kRows; ++r)
+    for (int k = 0; k < kDepth; ++k)
+      for (int j = 0; j < kColumns; ++j) expected[r * kColumns + j] += static_cast<double>(a[r * kDepth + k]) * b[k * kColumns + j];
+  for (int i = 0; i < count; ++i) {
+    const auto& kernel = *kernels[i];
+    SCOPED_TRACE(kernel.name);
+    ASSERT_EQ(kRows % kernel.rows, 0);
+    ASSERT_EQ(kColumns % kernel.panel, 0);
+    std::vector<float> packed(b.size());
+    for (int k = 0; k < kDepth; ++k)
+      for (int j = 0; j < kColumns; ++j)
+        packed[(static_cast<std::size_t>(j / kernel.panel) * kDepth + k) * kernel.panel + j % kernel.panel] = b[k * kColumns + j];
+    std::vector<float> c(static_cast<std::size_t>(kRows) * kColumns, -1.f);
+    kernel.run(a.data(), packed.data(), c.data(), kRows, kDepth, kColumns);
+    for (std::size_t n = 0; n < c.size(); ++n) ASSERT_NEAR(c[n], expected[n], 1e-4) << "at " << n;
+  }
+}
+
+}  // namespace
+}  // namespace neuflow::model
