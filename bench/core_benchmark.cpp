@@ -1,6 +1,9 @@
 // Benchmarks of the NeuFlow-V2 core: per pair and per streamed frame at the sizes of the
 // reference measurements, with achieved GFLOP/s as a fraction of the sgemm peak measured in
-// the same process (absolute times on a shared machine drift; the ratio does not).
+// the same process (absolute times on a shared machine drift; the ratio does not). The CPU
+// runs twice: `direct_*` with every convolution by oneDNN's direct algorithm, then the
+// default (Winograd on the stride-1 3×3 layers), whose `x_direct` is its speed-up over the
+// direct run just before. GFLOP/s always counts the direct convolutions' arithmetic.
 //
 //   neuflow-bench-core [--model CKPT] [--threads N] [--sizes 320x256,768x432] [benchmark flags]
 //
@@ -45,7 +48,8 @@ struct Config {
 
 Config g_config;
 double g_sgemm_peak_gflops = 0;
-std::map<std::string, double> g_cpu_ms;  // "pair/768x432" → the CPU's time in this run
+std::map<std::string, double> g_cpu_ms;     // "pair/768x432" → the CPU's time in this run
+std::map<std::string, double> g_direct_ms;  // the same with direct convolutions only
 std::shared_ptr<const FlowModel> g_model;
 
 double peak_rss_mb() {
@@ -110,23 +114,36 @@ void report(benchmark::State& state, double seconds_per_item, double flops) {
   state.counters["peak_rss_MB"] = peak_rss_mb();
 }
 
-neuflow::model::SessionOptions options_for(neuflow::model::Backend backend) {
-  return {.threads = g_config.threads, .backend = backend, .device = g_config.device};
+// What one benchmark runs on: a backend, and on the CPU how its 3×3 convolutions are computed.
+struct Variant {
+  neuflow::model::Backend backend = neuflow::model::Backend::cpu;
+  neuflow::model::CpuConvolution convolution = neuflow::model::CpuConvolution::automatic;
+};
+
+neuflow::model::SessionOptions options_for(const Variant& v) {
+  return {.threads = g_config.threads, .backend = v.backend, .device = g_config.device, .cpu_convolution = v.convolution};
 }
 
-// On the Vulkan backend: the time against the CPU's for the same work, measured just before.
-void compare_to_cpu(benchmark::State& state, const std::string& key, neuflow::model::Backend backend) {
-  if (backend == neuflow::model::Backend::cpu) {
+// The CPU's default against its direct-only run of the same work, measured just before; on
+// the Vulkan backend, the time against the CPU's default.
+void compare(benchmark::State& state, const std::string& key, const Variant& v) {
+  if (v.backend == neuflow::model::Backend::cpu && v.convolution == neuflow::model::CpuConvolution::direct) {
+    g_direct_ms[key] = state.counters["ms"];
+  } else if (v.backend == neuflow::model::Backend::cpu) {
     g_cpu_ms[key] = state.counters["ms"];
+    if (const auto it = g_direct_ms.find(key); it != g_direct_ms.end() && state.counters["ms"] > 0) {
+      state.counters["direct_ms"] = it->second;
+      state.counters["x_direct"] = it->second / state.counters["ms"];
+    }
   } else if (const auto it = g_cpu_ms.find(key); it != g_cpu_ms.end() && state.counters["ms"] > 0) {
     state.counters["cpu_ms"] = it->second;
     state.counters["x_cpu"] = it->second / state.counters["ms"];
   }
 }
 
-void BM_Pair(benchmark::State& state, int width, int height, neuflow::model::Backend backend) {
-  FlowSession session(g_model, options_for(backend));
-  if (backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
+void BM_Pair(benchmark::State& state, int width, int height, Variant variant) {
+  FlowSession session(g_model, options_for(variant));
+  if (variant.backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
   const auto frames = load_frames(width, height);
   session.compute(view(frames[0]), view(frames[1]));  // warm-up: primitives and buffers
   double total = 0;
@@ -139,12 +156,12 @@ void BM_Pair(benchmark::State& state, int width, int height, neuflow::model::Bac
     ++i;
   }
   report(state, total / static_cast<double>(state.iterations()), neuflow::model::network_cost(height, width).pair());
-  compare_to_cpu(state, "pair/" + std::to_string(width) + "x" + std::to_string(height), backend);
+  compare(state, "pair/" + std::to_string(width) + "x" + std::to_string(height), variant);
 }
 
-void BM_Stream(benchmark::State& state, int width, int height, neuflow::model::Backend backend) {
-  FlowSession session(g_model, options_for(backend));
-  if (backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
+void BM_Stream(benchmark::State& state, int width, int height, Variant variant) {
+  FlowSession session(g_model, options_for(variant));
+  if (variant.backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
   const auto frames = load_frames(width, height);
   session.push(view(frames[0]));
   session.push(view(frames[1]));  // warm-up
@@ -159,13 +176,13 @@ void BM_Stream(benchmark::State& state, int width, int height, neuflow::model::B
   }
   report(state, total / static_cast<double>(state.iterations()),
          neuflow::model::network_cost(height, width).stream_frame());
-  compare_to_cpu(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), backend);
+  compare(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), variant);
 }
 
 // Where a streamed frame's time goes: the observer is called at the end of each stage, so the
 // time between consecutive calls is the stage's (refinement iterations summed per scale).
-void BM_StreamStages(benchmark::State& state, int width, int height) {
-  FlowSession session(g_model, options_for(neuflow::model::Backend::cpu));
+void BM_StreamStages(benchmark::State& state, int width, int height, Variant variant) {
+  FlowSession session(g_model, options_for(variant));
   const auto frames = load_frames(width, height);
   std::map<std::string, double> stage_seconds;
   auto last = std::chrono::steady_clock::now();
@@ -262,22 +279,31 @@ int main(int argc, char** argv) {
   for (const auto& [w, h] : g_config.sizes) {
     const std::string size = std::to_string(w) + "x" + std::to_string(h);
     using neuflow::model::Backend;
-    benchmark::RegisterBenchmark(("pair/" + size).c_str(), BM_Pair, w, h, Backend::cpu)
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(2.0);
-    benchmark::RegisterBenchmark(("stream/" + size).c_str(), BM_Stream, w, h, Backend::cpu)
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(2.0);
-    if (g_config.vulkan) {
-      // Lavapipe (Vulkan on the CPU) runs these too, but its times say nothing of a GPU's.
-      benchmark::RegisterBenchmark(("vulkan_pair/" + size).c_str(), BM_Pair, w, h, Backend::vulkan)
+    using neuflow::model::CpuConvolution;
+    const Variant direct{Backend::cpu, CpuConvolution::direct}, cpu{Backend::cpu, CpuConvolution::automatic};
+    const Variant vulkan{Backend::vulkan, CpuConvolution::automatic};
+    for (const char* mode : {"pair", "stream"}) {
+      const auto run = std::string(mode) == "pair" ? BM_Pair : BM_Stream;
+      benchmark::RegisterBenchmark(("direct_" + std::string(mode) + "/" + size).c_str(), run, w, h, direct)
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
-      benchmark::RegisterBenchmark(("vulkan_stream/" + size).c_str(), BM_Stream, w, h, Backend::vulkan)
+      benchmark::RegisterBenchmark((std::string(mode) + "/" + size).c_str(), run, w, h, cpu)
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
     }
-    benchmark::RegisterBenchmark(("stream_stages/" + size).c_str(), BM_StreamStages, w, h)
+    if (g_config.vulkan) {
+      // Lavapipe (Vulkan on the CPU) runs these too, but its times say nothing of a GPU's.
+      benchmark::RegisterBenchmark(("vulkan_pair/" + size).c_str(), BM_Pair, w, h, vulkan)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(2.0);
+      benchmark::RegisterBenchmark(("vulkan_stream/" + size).c_str(), BM_Stream, w, h, vulkan)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(2.0);
+    }
+    benchmark::RegisterBenchmark(("direct_stream_stages/" + size).c_str(), BM_StreamStages, w, h, direct)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(3);
+    benchmark::RegisterBenchmark(("stream_stages/" + size).c_str(), BM_StreamStages, w, h, cpu)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(3);
   }

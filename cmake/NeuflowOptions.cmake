@@ -17,8 +17,11 @@ target_compile_options(neuflow_options INTERFACE
 # (numeric code here deliberately accumulates floats in double).
 
 # AVX2+FMA are the floor of the deployment targets we measure on; the Jetson (aarch64) build
-# takes the compiler's default there.
-if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64")
+# takes the compiler's default there. NEUFLOW_X86_AVX2=OFF builds x86 for its baseline (SSE2),
+# which proves the portable code paths (the Winograd transforms and product kernel) on x86;
+# code that needs AVX2 or AVX-512 is chosen at run time either way.
+option(NEUFLOW_X86_AVX2 "Compile for AVX2+FMA on x86-64 (OFF: the x86-64 baseline)" ON)
+if(CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64" AND NEUFLOW_X86_AVX2)
   target_compile_options(neuflow_options INTERFACE -mavx2 -mfma -mf16c)
 endif()
 

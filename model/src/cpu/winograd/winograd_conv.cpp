@@ -34,17 +34,15 @@ int divide_up(int v, int m) { return (v + m - 1) / m; }
 // panel of output channels, and a thread's whole workspace (36 points of inputs and
 // products) stays within a share of L3. Larger blocks read the filters fewer times.
 constexpr std::size_t kPointInputBytes = 256 * 1024;
-constexpr std::size_t kThreadWorkspaceBytes = 16 * 1024 * 1024;
+constexpr std::size_t kThreadWorkspaceBytes = 6 * 1024 * 1024;
 constexpr int kMaxBlockTiles = 480;
 
-Float8 activate(Float8 v, Activation a) {
-  switch (a) {
-    case Activation::none: return v;
-    case Activation::leaky_relu: return v > 0.f ? v : 0.1f * v;
-    case Activation::relu: return v > 0.f ? v : Float8{};
-    case Activation::gelu:
-      for (int i = 0; i < kLanes; ++i) v[i] = 0.5f * v[i] * (1.f + std::erf(v[i] * 0.70710678118654752f));
-      return v;
+template <Activation A>
+Float8 activate(Float8 v) {
+  if constexpr (A == Activation::leaky_relu) return v > 0.f ? v : 0.1f * v;
+  if constexpr (A == Activation::relu) return v > 0.f ? v : Float8{};
+  if constexpr (A == Activation::gelu) {
+    for (int i = 0; i < kLanes; ++i) v[i] = 0.5f * v[i] * (1.f + std::erf(v[i] * 0.70710678118654752f));
   }
   return v;
 }
@@ -114,12 +112,19 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
     const bool inside = y0 >= 0 && x0 >= 0 && y0 + kInputTile <= height_ && x0 + kInputTile <= width_;
     for (int cb = 0; cb < in_channels_ / kLanes; ++cb) {
       const float* src = input + cb * plane;
-      for (int i = 0; i < kInputTile; ++i) {
-        const int y = y0 + i;
-        for (int j = 0; j < kInputTile; ++j) {
-          const int x = x0 + j;
-          const bool here = inside || (y >= 0 && y < height_ && x >= 0 && x < width_);
-          d[i * kInputTile + j] = here ? load8(src + (static_cast<std::size_t>(y) * width_ + x) * kLanes) : Float8{};
+      if (inside) {
+        const float* corner = src + (static_cast<std::size_t>(y0) * width_ + x0) * kLanes;
+        for (int i = 0; i < kInputTile; ++i) {
+          for (int j = 0; j < kInputTile; ++j) d[i * kInputTile + j] = load8(corner + (i * width_ + j) * kLanes);
+        }
+      } else {  // a border tile: the padding is zeros
+        for (int i = 0; i < kInputTile; ++i) {
+          const int y = y0 + i;
+          for (int j = 0; j < kInputTile; ++j) {
+            const int x = x0 + j;
+            const bool here = y >= 0 && y < height_ && x >= 0 && x < width_;
+            d[i * kInputTile + j] = here ? load8(src + (static_cast<std::size_t>(y) * width_ + x) * kLanes) : Float8{};
+          }
         }
       }
       transform_input(d, v);
@@ -137,6 +142,18 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
 
 void WinogradConv::transform_outputs(const float* products, int first, int count, const float* addend,
                                      float* output) const {
+  switch (activation_) {
+    case Activation::none: return transform_outputs_as<Activation::none>(products, first, count, addend, output);
+    case Activation::leaky_relu:
+      return transform_outputs_as<Activation::leaky_relu>(products, first, count, addend, output);
+    case Activation::relu: return transform_outputs_as<Activation::relu>(products, first, count, addend, output);
+    case Activation::gelu: return transform_outputs_as<Activation::gelu>(products, first, count, addend, output);
+  }
+}
+
+template <Activation A>
+void WinogradConv::transform_outputs_as(const float* products, int first, int count, const float* addend,
+                                        float* output) const {
   const std::size_t point_stride = product_stride_;
   const std::size_t plane = static_cast<std::size_t>(height_) * width_ * kLanes;
   Float8 m[kPoints], o[kOutputTile * kOutputTile];
@@ -151,12 +168,13 @@ void WinogradConv::transform_outputs(const float* products, int first, int count
       for (int xi = 0; xi < kPoints; ++xi) m[xi] = load8(src + xi * point_stride);
       transform_output(m, o);
       const Float8 bias = load8(bias_.data() + kb * kLanes);
+      const std::size_t corner = kb * plane + (static_cast<std::size_t>(y0) * width_ + x0) * kLanes;
       for (int i = 0; i < rows; ++i) {
         for (int j = 0; j < cols; ++j) {
-          const std::size_t at = kb * plane + (static_cast<std::size_t>(y0 + i) * width_ + x0 + j) * kLanes;
+          const std::size_t at = corner + static_cast<std::size_t>(i * width_ + j) * kLanes;
           Float8 value = o[i * kOutputTile + j] + bias;
           if (addend) value += load8(addend + at);
-          store8(output + at, activate(value, activation_));
+          store8(output + at, activate<A>(value));
         }
       }
     }

@@ -32,6 +32,9 @@ class WinogradConv {
  private:
   void transform_inputs(const float* input, int first_tile, int count, float* points) const;
   void transform_outputs(const float* products, int first_tile, int count, const float* addend, float* output) const;
+  template <Activation A>
+  void transform_outputs_as(const float* products, int first_tile, int count, const float* addend,
+                            float* output) const;
 
   int height_, width_;
   int in_channels_;      // padded to 8
