@@ -1,6 +1,7 @@
 #include "dnnl/conv_op.hpp"
 
 #include <cstring>
+#include <utility>
 #include <stdexcept>
 
 #include "dnnl/context.hpp"
@@ -27,15 +28,35 @@ dnnl::primitive_attr make_attr(const ConvParams& p) {
   return attr;
 }
 
-// Where Winograd F(4×4, 3×3) measured faster than oneDNN's direct convolution on 2 Zen 3
-// cores (docs/benchmarks.md, "Winograd"): every stride-1 3×3 layer of the network with at
-// least this many input channels.
+// Where Winograd F(4×4, 3×3) measured faster than oneDNN's direct convolution
+// (docs/benchmarks.md, "Winograd", neuflow-bench-conv): every stride-1 3×3 layer of the
+// network with at least this many input channels.
 constexpr int kWinogradMinInputChannels = 32;
 
+// The layout of `d` if Winograd reads and writes it in place.
+std::optional<ChannelLayout> winograd_layout(const memory::desc& d) {
+  const auto dims = d.dims();
+  if (dims.size() != 4) return std::nullopt;
+  for (const auto& [t, layout] : {std::pair{tag::nhwc, ChannelLayout::nhwc}, std::pair{tag::nChw8c, ChannelLayout::blocked8},
+                                 std::pair{tag::nChw16c, ChannelLayout::blocked16}}) {
+    if (d == memory::desc(dims, dt::f32, t)) return layout;
+  }
+  return std::nullopt;
+}
+
+// The blocked layout oneDNN's own convolutions pick on this CPU, so a Winograd layer between
+// them needs no reorder: 16 channels a block with AVX-512, 8 with AVX2.
+memory::format_tag preferred_blocking() {
+#if defined(__x86_64__)
+  if (__builtin_cpu_supports("avx512f")) return tag::nChw16c;
+#endif
+  return tag::nChw8c;
+}
+
 bool use_winograd(const ConvWeights& w, const ConvParams& p, CpuConvolution choice,
-                  const std::optional<memory::desc>& output, const memory::desc& blocked_output) {
+                  const std::optional<memory::desc>& output) {
   if (choice == CpuConvolution::direct || !WinogradConv::handles(w, p)) return false;
-  if (output && *output != blocked_output) return false;
+  if (output && !winograd_layout(*output)) return false;
   return choice == CpuConvolution::winograd || w.in_channels >= kWinogradMinInputChannels;
 }
 
@@ -56,15 +77,25 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
   out_h_ = (in_h + 2 * p.pad - w.kernel_h) / p.stride + 1;
   out_w_ = (in_w + 2 * p.pad - w.kernel_w) / p.stride + 1;
 
-  const memory::desc blocked_output({1, out_c_, out_h_, out_w_}, dt::f32, tag::nChw8c);
-  if (use_winograd(w, p, context.convolution, output, blocked_output)) {
-    winograd_.emplace(w, p, in_h, in_w, arena);
-    dst_ = arena.make(blocked_output);
-    const memory::desc blocked_input({1, w.in_channels, in_h, in_w}, dt::f32, tag::nChw8c);
-    if (blocked_input != input) {
-      reordered_input_ = arena.make(blocked_input);
-      input_reorder_ = dnnl::reorder(dnnl::reorder::primitive_desc(eng, input, eng, blocked_input));
+  if (use_winograd(w, p, context.convolution, output)) {
+    const memory::desc out_desc = output ? *output : memory::desc({1, out_c_, out_h_, out_w_}, dt::f32, preferred_blocking());
+    memory::desc in_desc = input;
+    if (!winograd_layout(input)) {  // not one it reads in place
+      in_desc = memory::desc({1, w.in_channels, in_h, in_w}, dt::f32, preferred_blocking());
+      reordered_input_ = arena.make(in_desc);
+      input_reorder_ = dnnl::reorder(dnnl::reorder::primitive_desc(eng, input, eng, in_desc));
     }
+    // GELU (erf) is applied afterwards by oneDNN's vectorized eltwise, in place: the output
+    // transform's scalar erf cost more than the convolution it follows.
+    ConvParams winograd_params = p;
+    if (p.activation == Activation::gelu) {
+      winograd_params.activation = Activation::none;
+      gelu_ = dnnl::eltwise_forward(dnnl::eltwise_forward::primitive_desc(
+          dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_gelu_erf, out_desc),
+          eng));
+    }
+    winograd_.emplace(w, winograd_params, in_h, in_w, *winograd_layout(in_desc), *winograd_layout(out_desc), arena);
+    dst_ = arena.make(out_desc);
     return;
   }
 
@@ -113,6 +144,7 @@ const memory& ConvOp::run(dnnl::stream& stream, const memory& input, const memor
     winograd_->run(static_cast<const float*>(src->get_data_handle()),
                    addend ? static_cast<const float*>(addend->get_data_handle()) : nullptr,
                    static_cast<float*>(dst_.get_data_handle()));
+    if (gelu_) gelu_->execute(stream, {{DNNL_ARG_SRC, dst_}, {DNNL_ARG_DST, dst_}});
     return dst_;
   }
   if (addend) {

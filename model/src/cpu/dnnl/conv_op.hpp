@@ -41,6 +41,7 @@ class ConvOp {
   int out_h_ = 0, out_w_ = 0, out_c_ = 0;
   bool accumulate_ = false;
   std::optional<WinogradConv> winograd_;
+  std::optional<dnnl::eltwise_forward> gelu_;  // after a Winograd convolution with GELU
   dnnl::convolution_forward conv_;
   dnnl::memory weights_, bias_, dst_;
   std::optional<dnnl::reorder> input_reorder_;

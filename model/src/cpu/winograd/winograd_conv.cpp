@@ -49,15 +49,30 @@ Float8 activate(Float8 v) {
 
 }  // namespace
 
+ChannelPlacement::ChannelPlacement(ChannelLayout layout, int c, int height, int w) : channels(c), width(w) {
+  const int lanes = layout == ChannelLayout::blocked16 ? 16 : 8;
+  if (layout == ChannelLayout::nhwc) {
+    pixel = block = c;
+    plane = 0;
+  } else {
+    pixel = block = lanes;
+    plane = static_cast<std::size_t>(height) * w * lanes;
+  }
+  partial_last_group = layout == ChannelLayout::nhwc && c % kLanes != 0;
+}
+
 bool WinogradConv::handles(const ConvWeights& w, const ConvParams& p) {
   return w.kernel_h == 3 && w.kernel_w == 3 && p.stride == 1 && p.pad == 1;
 }
 
-WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height, int width, ScratchArena& arena)
+WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height, int width,
+                           ChannelLayout input_layout, ChannelLayout output_layout, ScratchArena& arena)
     : height_(height),
       width_(width),
+      input_(input_layout, w.in_channels, height, width),
+      output_(output_layout, w.out_channels, height, width),
       in_channels_(round_up(w.in_channels, kLanes)),
-      out_channels_(round_up(w.out_channels, kLanes)),
+      out_channels_(round_up(w.out_channels, output_layout == ChannelLayout::blocked16 ? 2 * kLanes : kLanes)),
       kernel_(&gemm_kernel()),
       gemm_columns_(round_up(w.out_channels, kernel_->panel)),
       activation_(p.activation),
@@ -103,19 +118,28 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
 
 void WinogradConv::transform_inputs(const float* input, int first, int count, float* points) const {
   const std::size_t point_stride = input_stride_;
-  const std::size_t plane = static_cast<std::size_t>(height_) * width_ * kLanes;
+  const int groups = in_channels_ / kLanes;
+  const std::size_t row = static_cast<std::size_t>(width_) * input_.pixel;
   Float8 d[kPoints], v[kPoints];
+  // Eight channels of one pixel; in NHWC the last group may hold fewer, the rest zeros.
+  const auto load_group = [&](int group, std::size_t at) {
+    if (input_.partial_last_group && group == groups - 1) {
+      float lanes[kLanes] = {};
+      std::copy_n(input + at, input_.channels - group * kLanes, lanes);
+      return load8(lanes);
+    }
+    return load8(input + at);
+  };
   for (int t = 0; t < count; ++t) {
     const int tile = first + t;
     const int y0 = tile / tiles_x_ * kOutputTile - 1;
     const int x0 = tile % tiles_x_ * kOutputTile - 1;
     const bool inside = y0 >= 0 && x0 >= 0 && y0 + kInputTile <= height_ && x0 + kInputTile <= width_;
-    for (int cb = 0; cb < in_channels_ / kLanes; ++cb) {
-      const float* src = input + cb * plane;
+    for (int g = 0; g < groups; ++g) {
       if (inside) {
-        const float* corner = src + (static_cast<std::size_t>(y0) * width_ + x0) * kLanes;
+        const std::size_t corner = input_.at(g * kLanes, y0, x0);
         for (int i = 0; i < kInputTile; ++i) {
-          for (int j = 0; j < kInputTile; ++j) d[i * kInputTile + j] = load8(corner + (i * width_ + j) * kLanes);
+          for (int j = 0; j < kInputTile; ++j) d[i * kInputTile + j] = load_group(g, corner + i * row + j * input_.pixel);
         }
       } else {  // a border tile: the padding is zeros
         for (int i = 0; i < kInputTile; ++i) {
@@ -123,12 +147,12 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
           for (int j = 0; j < kInputTile; ++j) {
             const int x = x0 + j;
             const bool here = y >= 0 && y < height_ && x >= 0 && x < width_;
-            d[i * kInputTile + j] = here ? load8(src + (static_cast<std::size_t>(y) * width_ + x) * kLanes) : Float8{};
+            d[i * kInputTile + j] = here ? load_group(g, input_.at(g * kLanes, y, x)) : Float8{};
           }
         }
       }
       transform_input(d, v);
-      float* dst = points + static_cast<std::size_t>(t) * in_channels_ + cb * kLanes;
+      float* dst = points + static_cast<std::size_t>(t) * in_channels_ + g * kLanes;
       for (int xi = 0; xi < kPoints; ++xi) store8(dst + xi * point_stride, v[xi]);
     }
   }
@@ -155,7 +179,8 @@ template <Activation A>
 void WinogradConv::transform_outputs_as(const float* products, int first, int count, const float* addend,
                                         float* output) const {
   const std::size_t point_stride = product_stride_;
-  const std::size_t plane = static_cast<std::size_t>(height_) * width_ * kLanes;
+  const int groups = out_channels_ / kLanes;
+  const std::size_t row = static_cast<std::size_t>(width_) * output_.pixel;
   Float8 m[kPoints], o[kOutputTile * kOutputTile];
   for (int t = 0; t < count; ++t) {
     const int tile = first + t;
@@ -163,18 +188,27 @@ void WinogradConv::transform_outputs_as(const float* products, int first, int co
     const int x0 = tile % tiles_x_ * kOutputTile;
     const int rows = std::min(kOutputTile, height_ - y0);
     const int cols = std::min(kOutputTile, width_ - x0);
-    for (int kb = 0; kb < out_channels_ / kLanes; ++kb) {
-      const float* src = products + static_cast<std::size_t>(t) * gemm_columns_ + kb * kLanes;
+    for (int g = 0; g < groups; ++g) {
+      const float* src = products + static_cast<std::size_t>(t) * gemm_columns_ + g * kLanes;
       for (int xi = 0; xi < kPoints; ++xi) m[xi] = load8(src + xi * point_stride);
       transform_output(m, o);
-      const Float8 bias = load8(bias_.data() + kb * kLanes);
-      const std::size_t corner = kb * plane + (static_cast<std::size_t>(y0) * width_ + x0) * kLanes;
+      const Float8 bias = load8(bias_.data() + g * kLanes);
+      // In NHWC the last group may hold fewer than eight channels: only those are written.
+      const int lanes = output_.partial_last_group && g == groups - 1 ? output_.channels - g * kLanes : kLanes;
+      const std::size_t corner = output_.at(g * kLanes, y0, x0);
       for (int i = 0; i < rows; ++i) {
         for (int j = 0; j < cols; ++j) {
-          const std::size_t at = corner + static_cast<std::size_t>(i * width_ + j) * kLanes;
+          const std::size_t at = corner + i * row + static_cast<std::size_t>(j) * output_.pixel;
           Float8 value = o[i * kOutputTile + j] + bias;
-          if (addend) value += load8(addend + at);
-          store8(output + at, activate<A>(value));
+          if (lanes == kLanes) {
+            if (addend) value += load8(addend + at);
+            store8(output + at, activate<A>(value));
+          } else {
+            float partial[kLanes] = {};
+            if (addend) std::copy_n(addend + at, lanes, partial);
+            store8(partial, activate<A>(value + load8(partial)));
+            std::copy_n(partial, lanes, output + at);
+          }
         }
       }
     }

@@ -1,6 +1,7 @@
 #pragma once
-// A stride-1, pad-1 3×3 convolution by Winograd F(4×4, 3×3) on oneDNN's 8-channel blocked
-// layout (nChw8c), for one input size. The filters are transformed once here. run() splits
+// A stride-1, pad-1 3×3 convolution by Winograd F(4×4, 3×3) for one input size, reading and
+// writing the layouts its neighbours use (NHWC, oneDNN's nChw8c or nChw16c), so no reorder
+// sits between it and them. The filters are transformed once here. run() splits
 // the output's 4×4 tiles into blocks, one thread a block: each block's inputs are transformed
 // (Bᵀ d B), multiplied by the filters point by point (36 products of tiles × channels), and
 // transformed back (Aᵀ m A) with bias, addend and activation applied on the way out, so a
@@ -15,15 +16,34 @@
 
 namespace neuflow::model {
 
+// How one image's channels are laid out in memory.
+enum class ChannelLayout { nhwc, blocked8, blocked16 };  // NHWC, nChw8c, nChw16c
+
+// Where channel c of pixel (y, x) is, in floats from the start, for a layout and a shape.
+struct ChannelPlacement {
+  ChannelPlacement(ChannelLayout layout, int channels, int height, int width);
+  std::size_t at(int c, int y, int x) const {
+    return static_cast<std::size_t>(c / block) * plane + (static_cast<std::size_t>(y) * width + x) * pixel +
+           static_cast<std::size_t>(c % block);
+  }
+  int channels;      // real channels (blocked layouts hold zeros up to the block's end)
+  int width;
+  int pixel;         // floats from one pixel to the next
+  int block;         // channels stored together per pixel
+  std::size_t plane; // floats from one block of channels to the next
+  bool partial_last_group;  // NHWC with channels not a multiple of 8: the last 8 are partial
+};
+
 class WinogradConv {
  public:
   // True when these weights and parameters are a convolution this class computes.
   static bool handles(const ConvWeights& weights, const ConvParams& params);
 
-  WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width, ScratchArena& arena);
+  WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width,
+               ChannelLayout input_layout, ChannelLayout output_layout, ScratchArena& arena);
 
-  // input: [C/8][H][W][8]; addend (iff params.accumulate) and output: [K/8][H][W][8], the
-  // padding channels of the output written as zeros.
+  // input in input_layout; addend (iff params.accumulate) and output in output_layout, a
+  // blocked output's padding channels written as zeros.
   void run(const float* input, const float* addend, float* output) const;
 
   int tiles() const { return tiles_; }
@@ -37,8 +57,9 @@ class WinogradConv {
                             float* output) const;
 
   int height_, width_;
+  ChannelPlacement input_, output_;
   int in_channels_;      // padded to 8
-  int out_channels_;     // padded to 8: what the output holds
+  int out_channels_;     // padded to the output's block (8 in NHWC): what is written
   const winograd::GemmKernel* kernel_;
   int gemm_columns_;     // padded to the kernel's panel: the products' width
   Activation activation_;
