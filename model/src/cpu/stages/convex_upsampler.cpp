@@ -15,47 +15,55 @@ constexpr int kNeighbours = 9;
 }  // namespace
 
 ConvexUpsampler::ConvexUpsampler(const NetworkWeights& w, int h8, int w8, PlanContext& context)
-    : input_(h8, w8, 130) {
+    : input_(h8, w8, 130), mask_head_(&w.upsample_conv3) {
   conv1_.emplace(w.upsample_conv1, ConvParams{1, 1, Activation::relu}, nhwc_desc(h8, w8, 130), context);
-  conv2_.emplace(w.upsample_conv2, ConvParams{1, 1, Activation::relu}, conv1_->output_desc(), context);
-  // The mask in 8-channel blocks: channel k*64 + a*8 + b is block k*8 + a, lane b, so the
-  // combination below reads it in place without a conversion to NHWC.
-  conv3_.emplace(w.upsample_conv3, ConvParams{1, 0, Activation::none}, conv2_->output_desc(), context,
-                 dnnl::memory::desc({1, 576, h8, w8}, dnnl::memory::data_type::f32,
-                                    dnnl::memory::format_tag::nChw8c));
+  conv2_.emplace(w.upsample_conv2, ConvParams{1, 1, Activation::relu}, conv1_->output_desc(), context,
+                 nhwc_desc(h8, w8, w.upsample_conv2.out_channels));
+  // Bands of about 1 MiB of logits: a few coarse rows, always whole rows.
+  constexpr std::size_t kBandBytes = 1 << 20;
+  const std::size_t row_bytes = static_cast<std::size_t>(w8) * kNeighbours * kFactor * kFactor * sizeof(float);
+  band_rows_ = std::clamp(static_cast<int>(kBandBytes / row_bytes), 1, h8);
+  band_.resize(static_cast<std::size_t>(band_rows_) * w8 * kNeighbours * kFactor * kFactor);
 }
 
 void ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tensor& image_features, Tensor& flow) {
   copy_channels(all_channels(flow8), input_, 0);
   copy_channels(all_channels(image_features), input_, 2);
-  const auto& mask_memory = conv3_->run(stream, conv2_->run(stream, conv1_->run(stream, wrap_nhwc(input_))));
+  const auto& features_memory = conv2_->run(stream, conv1_->run(stream, wrap_nhwc(input_)));
   stream.wait();
-  // In 8-channel blocks the mask is a row-major [9, 64 · h8 · w8] matrix: row k holds the
-  // weight logits of neighbour k for every output pixel, contiguous in the output's x within
-  // a coarse pixel. The softmax over the 9 neighbours runs in three vectorizable passes:
-  // subtract each column's max, exp (oneDNN's jitted eltwise), then normalized weighted sums.
+  const auto* features = static_cast<const float*>(features_memory.get_data_handle());
   const int h8 = flow8.h, w8 = flow8.w;
-  const std::size_t plane = static_cast<std::size_t>(h8) * w8 * kFactor * kFactor;
-  auto* mask = static_cast<float*>(mask_memory.get_data_handle());
-  const long columns = static_cast<long>(plane);
-#pragma omp parallel for
-  for (long block = 0; block < columns; block += kFactor) {
-    float mx[kFactor];
-    for (int b = 0; b < kFactor; ++b) mx[b] = mask[block + b];
-    for (int k = 1; k < kNeighbours; ++k) {
-      for (int b = 0; b < kFactor; ++b) mx[b] = std::max(mx[b], mask[k * plane + block + b]);
-    }
-    for (int k = 0; k < kNeighbours; ++k) {
-      for (int b = 0; b < kFactor; ++b) mask[k * plane + block + b] -= mx[b];
-    }
-  }
-  exp_in_place(stream, mask, kNeighbours * plane);
-  stream.wait();
-
+  const int depth = mask_head_->in_channels;
+  constexpr int kWeights = kFactor * kFactor;           // output pixels per coarse pixel
+  constexpr int kLogits = kNeighbours * kWeights;       // channel k · 64 + a · 8 + b
   flow.resize(h8 * kFactor, w8 * kFactor, 2);
+  for (int y0 = 0; y0 < h8; y0 += band_rows_) {
+    const int rows = std::min(band_rows_, h8 - y0);
+    const int pixels = rows * w8;
+    float* logits = band_.data();
+    matmul(stream, {features + static_cast<std::size_t>(y0) * w8 * depth, pixels, depth, depth},
+           {mask_head_->weight.data(), kLogits, depth, depth}, logits, kLogits,
+           {.transpose_b = true, .bias = mask_head_->bias.data()});
+    stream.wait();
+    // Softmax over the 9 neighbours of each output pixel: subtract the max (64 output pixels
+    // side by side, so the loops vectorize), exp by oneDNN, then normalized weighted sums.
 #pragma omp parallel for
-  for (int y = 0; y < h8; ++y) {
-    for (int x = 0; x < w8; ++x) {
+    for (int p = 0; p < pixels; ++p) {
+      float* l = logits + static_cast<std::size_t>(p) * kLogits;
+      float mx[kWeights];
+      std::copy_n(l, kWeights, mx);
+      for (int k = 1; k < kNeighbours; ++k) {
+        for (int i = 0; i < kWeights; ++i) mx[i] = std::max(mx[i], l[k * kWeights + i]);
+      }
+      for (int k = 0; k < kNeighbours; ++k) {
+        for (int i = 0; i < kWeights; ++i) l[k * kWeights + i] -= mx[i];
+      }
+    }
+    exp_in_place(stream, logits, static_cast<std::size_t>(pixels) * kLogits);
+    stream.wait();
+#pragma omp parallel for
+    for (int p = 0; p < pixels; ++p) {
+      const int y = y0 + p / w8, x = p % w8;
       // The 3×3 neighbourhood of the coarse flow, zero outside; k = 3 * ky + kx.
       float nu[kNeighbours], nv[kNeighbours];
       for (int k = 0; k < kNeighbours; ++k) {
@@ -64,22 +72,21 @@ void ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tenso
         nu[k] = inside ? flow8.pixel(yy, xx)[0] : 0.f;
         nv[k] = inside ? flow8.pixel(yy, xx)[1] : 0.f;
       }
-      // Weight of neighbour k for output (8y + a, 8x + b): block (k * 8 + a), lane b.
-      const std::size_t pixel = (static_cast<std::size_t>(y) * w8 + x) * kFactor;
-      for (int a = 0; a < kFactor; ++a) {
-        float sum[kFactor] = {}, u[kFactor] = {}, v[kFactor] = {};
-        for (int k = 0; k < kNeighbours; ++k) {
-          const float* e = mask + static_cast<std::size_t>(k) * plane + a * (plane / kFactor) + pixel;
-          for (int b = 0; b < kFactor; ++b) {
-            sum[b] += e[b];
-            u[b] += e[b] * nu[k];
-            v[b] += e[b] * nv[k];
-          }
+      const float* e = logits + static_cast<std::size_t>(p) * kLogits;
+      float sum[kWeights] = {}, u[kWeights] = {}, v[kWeights] = {};
+      for (int k = 0; k < kNeighbours; ++k) {
+        for (int i = 0; i < kWeights; ++i) {
+          sum[i] += e[k * kWeights + i];
+          u[i] += e[k * kWeights + i] * nu[k];
+          v[i] += e[k * kWeights + i] * nv[k];
         }
+      }
+      // Weight i = 8a + b is output pixel (8y + a, 8x + b).
+      for (int a = 0; a < kFactor; ++a) {
         float* out = flow.pixel(y * kFactor + a, x * kFactor);
         for (int b = 0; b < kFactor; ++b) {
-          out[2 * b] = kFactor * u[b] / sum[b];
-          out[2 * b + 1] = kFactor * v[b] / sum[b];
+          out[2 * b] = kFactor * u[a * kFactor + b] / sum[a * kFactor + b];
+          out[2 * b + 1] = kFactor * v[a * kFactor + b] / sum[a * kFactor + b];
         }
       }
     }

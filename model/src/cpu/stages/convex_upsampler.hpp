@@ -1,9 +1,13 @@
 #pragma once
 // Convex upsampling of the 1/8 flow to full resolution: a mask head predicts, for each of the
 // 8×8 output pixels of a coarse pixel, softmax weights over its 3×3 coarse neighbourhood.
+// The head's last layer (1×1, 512 → 576 logits per coarse pixel), the softmax and the
+// weighted sum run band by band of coarse rows, so the whole-frame mask (576 floats per
+// coarse pixel: 75 MB at 1920×1088) is never held; a band stays in cache across the passes.
 #include <dnnl.hpp>
 
 #include <optional>
+#include <vector>
 
 #include "dnnl/conv_op.hpp"
 #include "tensor.hpp"
@@ -20,7 +24,10 @@ class ConvexUpsampler {
 
  private:
   Tensor input_;
-  std::optional<ConvOp> conv1_, conv2_, conv3_;
+  std::optional<ConvOp> conv1_, conv2_;  // conv2 writes NHWC: rows of 512 features per pixel
+  const ConvWeights* mask_head_;          // the 1×1 512 → 576 layer, [576][512] row-major
+  int band_rows_;
+  std::vector<float> band_;               // one band's logits: [pixels][9 · 64]
 };
 
 }  // namespace neuflow::model
