@@ -5,6 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <utility>
 #include <stdexcept>
 
 #include "winograd/packed_gemm.hpp"
@@ -45,6 +49,40 @@ Float8 activate(Float8 v) {
     for (int i = 0; i < kLanes; ++i) v[i] = 0.5f * v[i] * (1.f + std::erf(v[i] * 0.70710678118654752f));
   }
   return v;
+}
+
+// G g Gᵀ for every (output, input) pair of `w`, packed as `kernel` reads them.
+std::vector<float> transform_filters(const ConvWeights& w, const GemmKernel& kernel, int depth, int columns) {
+  const int panel = kernel.panel;
+  const int panels = columns / panel;
+  std::vector<float> filters(static_cast<std::size_t>(kPoints) * columns * depth, 0.f);
+  float points[kPoints];
+  for (int o = 0; o < w.out_channels; ++o) {
+    for (int c = 0; c < w.in_channels; ++c) {
+      transform_filter(w.weight.data() + (static_cast<std::size_t>(o) * w.in_channels + c) * 9, points);
+      for (int xi = 0; xi < kPoints; ++xi) {
+        const std::size_t at = static_cast<std::size_t>(xi) * panels + o / panel;
+        filters[(at * depth + c) * panel + o % panel] = points[xi];
+      }
+    }
+  }
+  return filters;
+}
+
+// The transformed filters are 4× the size of the 3×3 weights (~114 MB for the network), so
+// every session of a model shares them, the way sessions share the model: one copy per
+// layer for as long as a plan uses it. A live entry's plan keeps its session's model, and so
+// the weights its key points to, alive.
+std::shared_ptr<const std::vector<float>> shared_filters(const ConvWeights& w, const GemmKernel& kernel, int depth,
+                                                         int columns) {
+  static std::mutex mutex;
+  static std::map<std::pair<const ConvWeights*, const GemmKernel*>, std::weak_ptr<const std::vector<float>>> cache;
+  const std::lock_guard lock(mutex);
+  auto& entry = cache[{&w, &kernel}];
+  if (auto filters = entry.lock()) return filters;
+  auto filters = std::make_shared<const std::vector<float>>(transform_filters(w, kernel, depth, columns));
+  entry = filters;
+  return filters;
 }
 
 }  // namespace
@@ -98,20 +136,7 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
   thread_floats_ = kPoints * (input_stride_ + product_stride_);
   arena.reserve_workspace(sizeof(float) * thread_floats_ * static_cast<std::size_t>(threads_));
 
-  // Filters: G g Gᵀ for every (output, input) pair, packed as the GEMM reads them.
-  const int panel = kernel_->panel;
-  const int panels = gemm_columns_ / panel;
-  filters_.assign(static_cast<std::size_t>(kPoints) * gemm_columns_ * in_channels_, 0.f);
-  float points[kPoints];
-  for (int o = 0; o < w.out_channels; ++o) {
-    for (int c = 0; c < w.in_channels; ++c) {
-      transform_filter(w.weight.data() + (static_cast<std::size_t>(o) * w.in_channels + c) * 9, points);
-      for (int xi = 0; xi < kPoints; ++xi) {
-        const std::size_t at = static_cast<std::size_t>(xi) * panels + o / panel;
-        filters_[(at * in_channels_ + c) * panel + o % panel] = points[xi];
-      }
-    }
-  }
+  filters_ = shared_filters(w, *kernel_, in_channels_, gemm_columns_);
   bias_.assign(static_cast<std::size_t>(gemm_columns_), 0.f);
   std::copy(w.bias.begin(), w.bias.end(), bias_.begin());
 }
@@ -231,7 +256,7 @@ void WinogradConv::run(const float* input, const float* addend, float* output) c
       transform_inputs(input, first, count, points);
       for (int xi = 0; xi < kPoints; ++xi) {
         kernel_->run(points + xi * input_stride_,
-                    filters_.data() + static_cast<std::size_t>(xi) * gemm_columns_ * in_channels_,
+                    filters_->data() + static_cast<std::size_t>(xi) * gemm_columns_ * in_channels_,
                      products + xi * product_stride_, rows, in_channels_, gemm_columns_);
       }
       transform_outputs(products, first, count, addend, output);

@@ -7,6 +7,7 @@
 // transformed back (Aᵀ m A) with bias, addend and activation applied on the way out, so a
 // block's intermediate data stays in the core's cache.
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "dnnl/conv_params.hpp"
@@ -71,7 +72,8 @@ class WinogradConv {
   std::size_t input_stride_, product_stride_;  // floats from one point to the next in a block
   std::size_t thread_floats_;                  // workspace floats each thread uses
   const ScratchArena* arena_;
-  std::vector<float> filters_;  // [36][columns / panel][in_channels][panel]
+  // [36][columns / panel][in_channels][panel], shared by every plan of the same model.
+  std::shared_ptr<const std::vector<float>> filters_;
   std::vector<float> bias_;     // gemm_columns_ values
 };
 
