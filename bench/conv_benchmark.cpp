@@ -4,21 +4,29 @@
 // best of several runs; GFLOP/s counts the direct convolution's arithmetic for both, so
 // Winograd's figure can exceed the sgemm peak measured first.
 //
-//   neuflow-bench-conv [--size 768x432] [--threads 2] [--runs 10]
+// With --arena, instead: the CPU plan's transient-activation arena at that size, region by
+// region (one per stage; regions overlap, so the arena is the largest), in MB and bytes per
+// model pixel, for both ways of computing the convolutions.
+//
+//   neuflow-bench-conv [--size 768x432] [--threads 2] [--runs 10] [--arena [--model CKPT]]
 #include <oneapi/dnnl/dnnl.h>
 #include <omp.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "dnnl/context.hpp"
 #include "dnnl/conv_op.hpp"
+#include "network.hpp"
 #include "neuflow/model/architecture.hpp"
+#include "neuflow/model/flow_model.hpp"
 
 namespace {
 
@@ -68,18 +76,53 @@ double time_conv(const ConvWeights& w, int h, int width, CpuConvolution choice, 
   });
 }
 
+int print_arena(const std::string& model_path, int width, int height) {
+  std::shared_ptr<const FlowModel> model;
+  try {
+    model = FlowModel::load(model_path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "neuflow-bench-conv: %s\n(pass --model CKPT or set NEUFLOW_SHARED_DIR)\n", e.what());
+    return 66;
+  }
+  const double pixels = static_cast<double>(width) * height;
+  std::printf("arena at %dx%d (%.2f Mpixel), MB and bytes per pixel\n", width, height, pixels / 1e6);
+  std::printf("%-12s %8s %8s %8s %8s %8s\n", "region", "buffers", "direct", "B/px", "winograd", "B/px");
+  const NetworkPlan direct(model->weights(), height, width, CpuConvolution::direct);
+  const NetworkPlan winograd(model->weights(), height, width, CpuConvolution::winograd);
+  const auto& d = direct.arena().regions();
+  const auto& w = winograd.arena().regions();
+  for (std::size_t i = 0; i < d.size() && i < w.size(); ++i) {
+    std::printf("%-12s %8d %8.1f %8.0f %8.1f %8.0f\n", d[i].name.c_str(), d[i].buffers, d[i].bytes / 1e6,
+                d[i].bytes / pixels, w[i].bytes / 1e6, w[i].bytes / pixels);
+  }
+  std::printf("%-12s %8s %8.1f %8.0f %8.1f %8.0f\n", "workspace", "", direct.arena().workspace_bytes() / 1e6,
+              direct.arena().workspace_bytes() / pixels, winograd.arena().workspace_bytes() / 1e6,
+              winograd.arena().workspace_bytes() / pixels);
+  std::printf("%-12s %8s %8.1f %8.0f %8.1f %8.0f\n", "arena", "", direct.arena().size_bytes() / 1e6,
+              direct.arena().size_bytes() / pixels, winograd.arena().size_bytes() / 1e6,
+              winograd.arena().size_bytes() / pixels);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int width = 768, height = 432, threads = 2, runs = 10;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--size") && std::sscanf(argv[i + 1], "%dx%d", &width, &height) == 2) continue;
-    if (!std::strcmp(argv[i], "--threads")) { threads = std::stoi(argv[i + 1]); continue; }
-    if (!std::strcmp(argv[i], "--runs")) { runs = std::stoi(argv[i + 1]); continue; }
-    std::fprintf(stderr, "usage: neuflow-bench-conv [--size WxH] [--threads N] [--runs N]\n");
+  bool arena = false;
+  const char* shared_env = std::getenv("NEUFLOW_SHARED_DIR");
+  std::string model = std::string(shared_env && *shared_env ? shared_env : NEUFLOW_DEFAULT_SHARED_DIR) +
+                      "/fixtures/neuflow-v2-seed0/checkpoint.pth";
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--arena")) { arena = true; continue; }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--size") && std::sscanf(argv[i + 1], "%dx%d", &width, &height) == 2) { ++i; continue; }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--threads")) { threads = std::stoi(argv[++i]); continue; }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--runs")) { runs = std::stoi(argv[++i]); continue; }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--model")) { model = argv[++i]; continue; }
+    std::fprintf(stderr, "usage: neuflow-bench-conv [--size WxH] [--threads N] [--runs N] [--arena [--model CKPT]]\n");
     return 64;
   }
   omp_set_num_threads(threads);
+  if (arena) return print_arena(model, width, height);
   const double peak = sgemm_peak_gflops(runs);
   std::printf("size %dx%d, threads %d, sgemm peak %.1f GFLOP/s\n", width, height, threads, peak);
   std::printf("%-36s %5s %5s %9s %9s %9s %8s %8s %7s\n", "layer", "in", "out", "HxW", "direct_ms", "wino_ms",

@@ -19,8 +19,13 @@ ChannelSlice features_of(const Tensor& t) { return {&t, kContext, kFeatures}; }
 ChannelSlice context_of(const Tensor& t) { return {&t, 0, kContext}; }
 
 // Starts a new arena region: the stage constructed with it may reuse earlier stages' memory.
-PlanContext& next_region(PlanContext& context) {
-  context.arena.next_region();
+PlanContext& next_region(PlanContext& context, const char* name) {
+  context.arena.next_region(name);
+  return context;
+}
+
+PlanContext& first_region(PlanContext& context, const char* name) {
+  context.arena.name_region(name);
   return context;
 }
 
@@ -30,13 +35,13 @@ NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width, CpuConv
     : height_(height),
       width_(width),
       context_{{}, convolution},
-      encoder_(w, height, width, context_),
+      encoder_(w, height, width, first_region(context_, "encoder")),
       attention_(w, height / 16, width / 16),
       matching_(height / 16, width / 16, kFeatures),
-      refine_s16_(w.refine_s16, height / 16, width / 16, next_region(context_)),
-      merge_(w, height / 8, width / 8, next_region(context_)),
-      refine_s8_(w.refine_s8, height / 8, width / 8, next_region(context_)),
-      upsampler_(w, height / 8, width / 8, next_region(context_)),
+      refine_s16_(w.refine_s16, height / 16, width / 16, next_region(context_, "refine_s16")),
+      merge_(w, height / 8, width / 8, next_region(context_, "merge_s8")),
+      refine_s8_(w.refine_s8, height / 8, width / 8, next_region(context_, "refine_s8")),
+      upsampler_(w, height / 8, width / 8, next_region(context_, "upsampler")),
       context16_(height / 16, width / 16, kContext),
       flow8_(height / 8, width / 8, 2) {
   context_.arena.finalize();

@@ -23,6 +23,9 @@ class NetworkPlan {
   NetworkPlan(const NetworkWeights& weights, int height, int width, CpuConvolution convolution);
 
   int height() const { return height_; }
+  // The transient activations' arena: its regions (one per stage, overlapping) and the
+  // Winograd workspace, for the memory table of neuflow-bench-conv --arena.
+  const ScratchArena& arena() const { return context_.arena; }
   int width() const { return width_; }
 
   // image: [height, width, 3] RGB in 0..1.

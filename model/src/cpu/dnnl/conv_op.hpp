@@ -37,6 +37,12 @@ class ConvOp {
   int out_channels() const { return out_c_; }
   bool is_winograd() const { return winograd_.has_value(); }
 
+  // Releases to `arena` what this convolution needs only while it runs (an input converted
+  // to its layout); call once the operations after it are built, see ScratchArena::release.
+  void release_scratch(ScratchArena& arena) const {
+    if (input_reorder_) arena.release(reordered_input_);
+  }
+
  private:
   int out_h_ = 0, out_w_ = 0, out_c_ = 0;
   bool accumulate_ = false;

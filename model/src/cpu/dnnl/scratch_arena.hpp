@@ -1,11 +1,15 @@
 #pragma once
 // One allocation for the transient activations of all stages of a plan. Stages run one after
 // another, so buffers of different regions may share memory; buffers of the same region never
-// overlap. Memories handed out before finalize() get their storage when it runs.
+// overlap while both are in use. A stage whose operations run in the order it builds them
+// may release() a buffer once it has built the last operation that reads it: buffers made
+// afterwards may take its place. Memories handed out before finalize() get their storage
+// when it runs.
 #include <dnnl.hpp>
 
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace neuflow::model {
@@ -15,8 +19,22 @@ class ScratchArena {
   // A memory in the current region (no storage until finalize()).
   dnnl::memory make(const dnnl::memory::desc& desc);
 
-  // Buffers made after this may overlap those of earlier regions.
-  void next_region();
+  // `memory` (made in the current region) is read by nothing built after this point.
+  void release(const dnnl::memory& memory);
+
+  // Buffers made after this may overlap those of earlier regions. `name` says whose they are.
+  void next_region(std::string name = {});
+  // Names the current region (the first one has no next_region call).
+  void name_region(std::string name);
+
+  // What each region holds, for the memory table of a plan.
+  struct Region {
+    std::string name;
+    std::size_t bytes = 0;
+    int buffers = 0;
+  };
+  const std::vector<Region>& regions() const { return regions_; }
+  std::size_t workspace_bytes() const { return workspace_size_; }
 
   // Allocates the largest region's size once and binds every memory made so far.
   void finalize();
@@ -32,8 +50,16 @@ class ScratchArena {
   struct Binding {
     dnnl::memory memory;
     std::size_t offset;
+    std::size_t size;
+    std::size_t region;
+    bool released = false;
+  };
+  struct Span {
+    std::size_t offset, size;
   };
   std::vector<Binding> bindings_;
+  std::vector<Span> free_;  // released spans of the current region, by offset
+  std::vector<Region> regions_{1};
   std::size_t region_end_ = 0;
   std::size_t size_ = 0;
   std::size_t workspace_size_ = 0;

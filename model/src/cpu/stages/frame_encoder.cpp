@@ -29,7 +29,10 @@ FrameEncoder::Block FrameEncoder::make_block(const ConvBlockWeights& w, int stri
                                              const dnnl::memory::desc& input, PlanContext& context) {
   Block b;
   b.conv1.emplace(w.conv1, ConvParams{stride, pad, Activation::leaky_relu}, input, context);
+  b.conv1->release_scratch(context.arena);
   b.conv2.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, b.conv1->output_desc(), context);
+  b.conv2->release_scratch(context.arena);
+  context.arena.release(b.conv1->output());  // read by conv2 only
   return b;
 }
 
@@ -42,14 +45,26 @@ FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, PlanC
   half_.resize(height / 2, width / 2, 3);
   quarter_.resize(height / 4, width / 4, 3);
   eighth_.resize(height / 8, width / 8, 3);
+  // Built in the order run() runs them, each buffer released once what reads it is built, so
+  // the region holds only what is alive at once (at 1920×1088 the 1/8 tensors are 130 KB a
+  // channel).
+  ScratchArena& arena = context.arena;
   block_8_1_ = make_block(w.block_8_1, 4, 2, nhwc_desc(height / 2, width / 2, 3), context);
   block_8_2_ = make_block(w.block_8_2, 2, 2, nhwc_desc(height / 4, width / 4, 3), context);
   concat_8_ = make_concat(block_8_1_.conv2->output_desc(), block_8_2_.conv2->output_desc(), cat8_, context);
+  arena.release(block_8_1_.conv2->output());
+  arena.release(block_8_2_.conv2->output());
   block_cat_8_ = make_block(w.block_cat_8, 1, 1, cat8_.get_desc(), context);
+  arena.release(cat8_);
   block_16_1_ = make_block(w.block_16_1, 2, 2, nhwc_desc(height / 8, width / 8, 3), context);
   block_8_16_ = make_block(w.block_8_16, 2, 2, block_cat_8_.conv2->output_desc(), context);
+  arena.release(block_cat_8_.conv2->output());  // f8: read by to_nhwc and block_8_16
   concat_16_ = make_concat(block_16_1_.conv2->output_desc(), block_8_16_.conv2->output_desc(), cat16_, context);
+  arena.release(block_16_1_.conv2->output());
+  arena.release(block_8_16_.conv2->output());
   block_cat_16_ = make_block(w.block_cat_16, 1, 1, cat16_.get_desc(), context);
+  arena.release(cat16_);
+  arena.release(block_cat_16_.conv2->output());  // read by to_nhwc before conv_s8 runs
   conv_s8_ = make_block(w.conv_s8, 8, 0, nhwc_desc(height, width, 3), context);
 }
 

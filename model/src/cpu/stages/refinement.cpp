@@ -21,13 +21,25 @@ Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& co
   conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c), context);
   conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), context,
                           conv1_->output_desc());
+  // The chain runs in the order it is built, and an iteration hands nothing to the next
+  // through the arena (the hidden state and flow go through input_), so each convolution's
+  // output is released once the next one is built; conv1_constant's stays for the pair.
+  ScratchArena& arena = context.arena;
+  conv1_->release_scratch(arena);
+  conv1_constant_->release_scratch(arena);
   conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, conv1_->output_desc(), context);
+  conv2_->release_scratch(arena);
+  arena.release(conv1_->output());
   const ConvOp* prev = &*conv2_;
   for (std::size_t i = 0; i < layers_.size(); ++i) {
     layers_[i].emplace(w.conv_layers[i], ConvParams{1, 1, Activation::leaky_relu}, prev->output_desc(), context);
+    layers_[i]->release_scratch(arena);
+    arena.release(prev->output());
     prev = &*layers_[i];
   }
   conv3_.emplace(w.conv3, ConvParams{1, 1, Activation::none}, prev->output_desc(), context);
+  conv3_->release_scratch(arena);
+  arena.release(prev->output());
 }
 
 void Refinement::begin(dnnl::stream& stream, const Tensor& context) {
