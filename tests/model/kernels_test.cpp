@@ -145,5 +145,30 @@ INSTANTIATE_TEST_SUITE_P(NetworkShapes, ConvOpTest,
                                            ConvCase{20, 36, 3, 1, 1, 13, 18, true, Activation::leaky_relu, true}),
                                            ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd)));
 
+// The arena reuses a released buffer's bytes for buffers made afterwards in the same region,
+// merges neighbouring released spans, and never lets two unreleased buffers overlap.
+TEST(ScratchArena, ReleasedSpansAreReusedAndLiveBuffersNeverOverlap) {
+  const auto floats = [](int n) { return dnnl::memory::desc({n}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::a); };
+  ScratchArena arena;
+  const dnnl::memory a = arena.make(floats(1024)), b = arena.make(floats(1024)), c = arena.make(floats(1024));
+  arena.release(a);
+  arena.release(b);  // merged with a: 8 KiB free at the start
+  const dnnl::memory d = arena.make(floats(2048));  // fits the merged span exactly
+  const dnnl::memory e = arena.make(floats(16));    // nothing free: after c
+  EXPECT_EQ(arena.regions().back().bytes, 3 * 4096u + 64u);
+  EXPECT_THROW(arena.release(a), std::logic_error);  // twice
+  arena.next_region("second");
+  EXPECT_THROW(arena.release(c), std::logic_error);  // of an earlier region
+  const dnnl::memory f = arena.make(floats(4096));   // overlaps the first region: allowed
+  arena.finalize();
+  const auto at = [](const dnnl::memory& m) { return static_cast<const char*>(m.get_data_handle()); };
+  EXPECT_EQ(at(d), at(a));
+  EXPECT_GE(at(e), at(c) + 4096);
+  EXPECT_EQ(at(f), at(a));
+  EXPECT_EQ(arena.regions().size(), 2u);
+  EXPECT_EQ(arena.regions()[1].name, "second");
+  EXPECT_EQ(arena.size_bytes(), 16384u);
+}
+
 }  // namespace
 }  // namespace neuflow::model
