@@ -1,5 +1,5 @@
 #pragma once
-// Keeps neuflowsink's CSV index (index,from_frame,to_frame,from_pts_ns,to_pts_ns,file: see
+// Keeps neuflowsink's CSV index (index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source: see
 // neuflow/flow/flow_index.hpp) from growing forever when old flow files are deleted: rewrites
 // it, atomically, with the rows whose files still exist. No GStreamer in here.
 #include <cstddef>

@@ -13,7 +13,7 @@
  *
  * A CSV index (#neuflowsink:index-location, by default `index.csv` beside the flow files)
  * gets one row per file written, flushed at once:
- * `index,from_frame,to_frame,from_pts_ns,to_pts_ns,file`. The frame numbers and
+ * `index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source` (the sources are empty here: they name image files, which only `neuflow convert` reads). The frame numbers and
  * timestamps are those of the two frames the flow was computed from; after dropped frames
  * they are not consecutive, so consumers should pair flows with frames through this file.
  *
@@ -410,6 +410,17 @@ static void gst_neuflow_sink_stop_writing(GstNeuflowFlowSink *sink) {
   gst_neuflow_sink_clear_run_state(self);
 }
 
+// Whether the index file at `path` starts with this version's header line.
+static bool index_has_current_header(const char *path) {
+  FILE *file = std::fopen(path, "r");
+  if (!file) return false;
+  const std::string header = neuflow::flow::flow_index_header();
+  std::string first(header.size() + 1, '\0');
+  const bool read = std::fgets(first.data(), static_cast<int>(first.size()), file) != nullptr;
+  std::fclose(file);
+  return read && first.c_str() == header;
+}
+
 // Appends one row to the index, opening it (and writing the header into an empty file)
 // the first time. Rows are appended, never rewritten: after a restart that reuses indices,
 // the last row for an index describes the file now on disk.
@@ -426,6 +437,17 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
       GST_ELEMENT_ERROR(self, RESOURCE, OPEN_WRITE,
                         ("Could not open the flow index \"%s\" for appending: %s.", self->index_path, g_strerror(err)),
                         (nullptr));
+      return false;
+    }
+    // Rows are appended only under the header they belong to, never to another format's.
+    if (st.st_size > 0 && !index_has_current_header(self->index_path)) {
+      GST_ELEMENT_ERROR(self, RESOURCE, OPEN_WRITE,
+                        ("The flow index \"%s\" has other columns than \"%s\" (written by another program or an "
+                         "older neuflow); move it away or set another index-location.",
+                         self->index_path, std::string(neuflow::flow::kFlowIndexColumns).c_str()),
+                        (nullptr));
+      std::fclose(self->index_file);
+      self->index_file = nullptr;
       return false;
     }
   }
@@ -522,8 +544,8 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
       gobject_class, PROP_INDEX_LOCATION,
       g_param_spec_string("index-location", "Index file location",
                           "CSV file that gets one row per flow file, flushed at once: "
-                          "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file (timestamps in ns, empty when "
-                          "unknown; file by its base name when it lies beside the index, else as written). Rows are "
+                          "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source (timestamps in ns, "
+                          "empty when unknown; sources always empty here, the format is shared with neuflow convert; file by its base name when it lies beside the index, else as written). Rows are "
                           "appended; the header is written into an empty file. With max-files or max-bytes set, the "
                           "index is rewritten atomically with only the rows of files still on disk whenever it holds "
                           "more than twice as many rows as files kept (at least 32 rows), and when the element "

@@ -39,10 +39,10 @@ std::string flow_name(int index) {
 std::string index_row(int index, int n) {
   const FlowSpec f = nth_flow(n);
   return std::to_string(index) + "," + std::to_string(f.from_frame) + "," + std::to_string(f.to_frame) + "," +
-         std::to_string(f.from_pts) + "," + std::to_string(f.to_pts) + "," + flow_name(index);
+         std::to_string(f.from_pts) + "," + std::to_string(f.to_pts) + "," + flow_name(index) + ",,";
 }
 
-const std::string kHeader = "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file";
+const std::string kHeader = "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source";
 
 RunningSink start_file_sink(const TempDir &dir, Properties properties) {
   properties.insert(properties.begin(), {"location", (dir / "flow_%03d.flo").string()});

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -127,9 +128,9 @@ TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
             (std::vector<std::string>{"flow_005.flo", "flow_006.flo", "flow_007.flo", "index.csv"}));
 
   EXPECT_EQ(read_lines(dir.path() / "index.csv"),
-            (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file",
-                                      "5,0,1,0,33333333,flow_005.flo", "6,1,3,33333333,100000000,flow_006.flo",
-                                      "7,3,4,,133333333,flow_007.flo"}));
+            (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source",
+                                      "5,0,1,0,33333333,flow_005.flo,,", "6,1,3,33333333,100000000,flow_006.flo,,",
+                                      "7,3,4,,133333333,flow_007.flo,,"}));
 
   EXPECT_EQ(uint64_property(s.element.get(), "flows-written"), 3u);
   EXPECT_EQ(uint64_property(s.element.get(), "bytes-written"),
@@ -182,8 +183,8 @@ TEST(NeuflowSink, IndexIsAppendedAcrossRestartsWithOneHeader) {
     ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 0, 1, 30, 40, 0.f})), GST_FLOW_OK);
   }
   EXPECT_EQ(read_lines(dir.path() / "index.csv"),
-            (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file", "0,0,1,0,10,flow_0.flo",
-                                      "1,1,2,10,20,flow_1.flo", "2,0,1,30,40,flow_2.flo"}));
+            (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source",
+                                      "0,0,1,0,10,flow_0.flo,,", "1,1,2,10,20,flow_1.flo,,", "2,0,1,30,40,flow_2.flo,,"}));
 }
 
 TEST(NeuflowSink, IndexElsewhereNamesTheFilesAsWritten) {
@@ -194,8 +195,8 @@ TEST(NeuflowSink, IndexElsewhereNamesTheFilesAsWritten) {
   ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 7, 8, 70, 80, 0.f})), GST_FLOW_OK);
   EXPECT_FALSE(fs::exists(flows.path() / "index.csv"));
   EXPECT_EQ(read_lines(elsewhere.path() / "list.csv"),
-            (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file",
-                                      "0,7,8,70,80,\"" + (flows / "x,y_00.npy").string() + "\""}));
+            (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source",
+                                      "0,7,8,70,80,\"" + (flows / "x,y_00.npy").string() + "\",,"}));
 }
 
 TEST(NeuflowSink, EmptyIndexLocationWritesNoIndex) {
@@ -267,6 +268,23 @@ TEST(NeuflowSink, WriteFailureStopsWithAnErrorNamingTheFileAndTheReason) {
   EXPECT_NE(error.message.find("\"" + file + "\""), std::string::npos) << error.message;
   EXPECT_NE(error.message.find("No such file or directory"), std::string::npos) << error.message;
   EXPECT_EQ(uint64_property(s.element.get(), "flows-written"), 1u);
+}
+
+// An index written in another format (an older neuflow's six columns) is not appended to:
+// its rows would not line up with the header.
+TEST(NeuflowSink, IndexWithOtherColumnsStopsWithAnErrorAndStaysAsItWas) {
+  TempDir dir;
+  const fs::path index = dir.path() / "index.csv";
+  const std::string old = "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file\n0,0,1,0,10,flow_0.flo\n";
+  std::ofstream(index) << old;
+  auto s = start_sink({{"location", (dir / "flow_%d.flo").string()}, {"index", "1"}});
+  ASSERT_TRUE(s.harness);
+  EXPECT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 1, 2, 10, 20, 0.f})), GST_FLOW_ERROR);
+  const ErrorMessage error = pop_error(s.bus.get());
+  ASSERT_TRUE(error.found);
+  EXPECT_NE(error.message.find("\"" + index.string() + "\" has other columns"), std::string::npos) << error.message;
+  std::ifstream in(index);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), old);
 }
 
 TEST(NeuflowSink, UnwritableIndexStopsWithAnErrorNamingIt) {

@@ -44,8 +44,8 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
 }  // namespace
 
 void FlowIndex::write() const {
-  std::string text = flow::flow_index_header({"from_source", "to_source"});
-  for (const auto& r : rows_) text += flow::flow_index_row(r.flow, {r.from_source, r.to_source});
+  std::string text = flow::flow_index_header();
+  for (const auto& r : rows_) text += flow::flow_index_row(r);
   write_text_atomically(path_, text);
 }
 

@@ -1,9 +1,7 @@
 #pragma once
 // The sidecar index of one converted input: one row per flow file, naming the two frames it
-// was computed from. The first six columns are those of neuflowsink's index
-// (index,from_frame,to_frame,from_pts_ns,to_pts_ns,file: neuflow/flow/flow_index.hpp), so one
-// reader handles both; two more name the source images: from_source,to_source (empty for
-// video frames).
+// was computed from, in the format neuflowsink writes too (neuflow/flow/flow_index.hpp);
+// from_source,to_source name the source images (empty for video frames).
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -14,12 +12,9 @@ namespace neuflow::cli {
 
 inline constexpr const char* kIndexFileName = "index.csv";
 
-struct IndexRow {
-  // index: the pair's position in the input, from 0; file: the flow file's name, relative
-  // to the index.
-  flow::FlowIndexRow flow;
-  std::string from_source, to_source;
-};
+// index: the pair's position in the input, from 0; file: the flow file's name, relative to
+// the index.
+using IndexRow = flow::FlowIndexRow;
 
 // The rows are kept in memory and the file replaced atomically by write(), so a reader
 // never sees a half-written index, and after --resume it lists every pair, computed or not.

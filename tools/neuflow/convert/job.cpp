@@ -165,7 +165,7 @@ void Conversion::convert_pair(const Frame& from, const Frame& to, InputOutcome& 
   const bool write_png = settings_.viz == VizMode::png && !(skipped && complete_png(png_path, width, height));
   render(*field, from.output_stem, write_png);
 
-  index_.add({{rows_, from.number, to.number, from.pts_ns, to.pts_ns, file}, from.source, to.source});
+  index_.add({rows_, from.number, to.number, from.pts_ns, to.pts_ns, file, from.source, to.source});
   ++rows_;
   progress_.pair_done();
 }
