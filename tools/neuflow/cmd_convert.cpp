@@ -37,7 +37,21 @@ struct ConvertArgs {
   std::int64_t max_frames = 0;
   std::string fps;    // --fps N or N/D
   std::string shard;  // --shard K/N
+  std::string frames;  // --frames A:B
 };
+
+// "A:B" with 0 <= A < B, or "A:" (to the end): the pairs whose first frame is A <= n < B.
+FrameRange parse_frames(const std::string& text) {
+  long long first = -1, end = -1;
+  char rest = 0;
+  int n = std::sscanf(text.c_str(), "%lld:%lld%c", &first, &end, &rest);
+  if (n == 1 && text.size() > 1 && text.back() == ':' && text.find(':') == text.size() - 1 && first >= 0) {
+    return {first, std::nullopt};
+  }
+  if (n == 2 && first >= 0 && end > first) return {first, end};
+  throw CommandError(kExitUsage, "--frames wants A:B with 0 <= A < B (the pairs whose first frame is A to B-1, frames "
+                                 "counted from 0) or A: (to the end), got '" + text + "'");
+}
 
 // "N" or "N/D" frames per second, positive.
 pipeline::FrameRate parse_rate(const std::string& text) {
@@ -104,6 +118,8 @@ void run_convert(const ConvertArgs& a) {
   const std::optional<pipeline::FrameRate> image_rate =
       a.fps.empty() ? std::nullopt : std::optional<pipeline::FrameRate>(parse_rate(a.fps));
   const Shard shard = a.shard.empty() ? Shard{} : parse_shard(a.shard);
+  const std::optional<FrameRange> frames = a.frames.empty() ? std::nullopt : std::optional(parse_frames(a.frames));
+  if (frames && a.max_frames > 0) throw CommandError(kExitUsage, "--frames and --max-frames both limit the frames: give one");
 
   std::shared_ptr<const model::FlowModel> model;
   try {
@@ -123,6 +139,7 @@ void run_convert(const ConvertArgs& a) {
   settings.max_flow = a.max_flow;
   settings.resume = a.resume;
   settings.max_frames = a.max_frames;
+  settings.frames = frames;
   settings.image_rate = image_rate;
 
   const int fd = ::fileno(stderr);
@@ -210,6 +227,12 @@ void register_convert(CLI::App& app) {
   sub->add_option("--shard", args->shard,
                   "Convert only the K-th of N shares of the inputs (K/N, K from 0: every N-th input starting at the "
                   "K-th), for job arrays; each input keeps the output folder name of a whole run");
+  sub->add_option("--frames", args->frames,
+                  "Convert only one range of each input (A:B, frames counted from 0: the pairs whose first frame "
+                  "is A to B-1, i.e. frames A to B; A: to the end), for splitting a long video across jobs: ranges "
+                  "that meet (0:1000, 1000:2000) share one frame and together hold every pair once. Writes "
+                  "index.A-B.csv and viz.A-B.mp4")
+      ->type_name("A:B");
   add_session_options(*sub, args->session);
   sub->add_option("INPUT", args->inputs,
                   "Folders of frames, video files or URIs, or two image files (a pair); several at once");

@@ -403,6 +403,43 @@ TEST_F(ConvertCli, ShardsTogetherWriteWhatOneRunWrites) {
   }
 }
 
+// A long video split by frame ranges that meet (--frames 0:2, 2:4, 4:): every flow file of
+// the whole run, byte for byte, and the ranges' indexes hold the whole run's rows.
+TEST_F(ConvertCli, FrameRangesTogetherWriteWhatOneRunWrites) {
+  TempDir dir;
+  const auto video = test::make_test_video(dir / "ball.mp4", 6, kWidth, kHeight);
+  ASSERT_EQ(convert(dir / "whole", {video.string()}).exit_code, 0);
+  for (const char* range : {"0:2", "2:4", "4:"}) {
+    const auto result = convert(dir / "ranges", {video.string(), "--frames", range});
+    ASSERT_EQ(result.exit_code, 0) << range << ": " << result.output;
+  }
+  auto whole = tree(dir / "whole"), ranges = tree(dir / "ranges");
+  EXPECT_EQ(whole.size(), 6u);  // 5 flows + index.csv
+  EXPECT_TRUE(ranges.count("ball/index.0-2.csv") && ranges.count("ball/index.2-4.csv") &&
+              ranges.count("ball/index.4-end.csv"));
+  const auto whole_index = read_csv(dir / "whole" / "ball" / "index.csv");
+  std::vector<std::vector<std::string>> joined{whole_index.front()};
+  for (const char* name : {"index.0-2.csv", "index.2-4.csv", "index.4-end.csv"}) {
+    const auto part = read_csv(dir / "ranges" / "ball" / name);
+    ASSERT_FALSE(part.empty());
+    EXPECT_EQ(part.front(), whole_index.front()) << name;
+    joined.insert(joined.end(), part.begin() + 1, part.end());
+    ranges.erase(std::string("ball/") + name);
+  }
+  EXPECT_EQ(joined, whole_index);
+  whole.erase("ball/index.csv");
+  EXPECT_TRUE(whole == ranges) << "the ranges wrote other flow files than the whole run";
+
+  // A range past the input's end fails that input; malformed ranges are usage errors.
+  const auto past = convert(dir / "past", {video.string(), "--frames", "9:12"});
+  EXPECT_EQ(past.exit_code, kExitDataError) << past.output;
+  EXPECT_NE(past.output.find("starts after its last"), std::string::npos) << past.output;
+  for (const char* bad : {"3:3", "4:2", "-1:2", "2", "a:b", ":5"}) {
+    EXPECT_EQ(convert(dir / "bad", {video.string(), "--frames", bad}).exit_code, kExitUsage) << bad;
+  }
+  EXPECT_EQ(convert(dir / "bad", {video.string(), "--frames", "0:2", "--max-frames", "3"}).exit_code, kExitUsage);
+}
+
 TEST(ConvertFrameRate, ImagesNamedByTheirCaptureTimeGiveTheirRate) {
   // The fixture camera's names: nanoseconds since the epoch, about 66.7 ms apart.
   const auto rate = rate_from_timestamps({"1684437740861809471", "1684437740927818192", "1684437740994402386",

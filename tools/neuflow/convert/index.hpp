@@ -10,8 +10,6 @@
 
 namespace neuflow::cli {
 
-inline constexpr const char* kIndexFileName = "index.csv";
-
 // index: the pair's position in the input, from 0; file: the flow file's name, relative to
 // the index.
 using IndexRow = flow::FlowIndexRow;

@@ -77,6 +77,11 @@ void create_folder(const fs::path& folder) {
   if (ec) throw InputError(kExitCantCreate, folder.string() + ": cannot create the output folder: " + ec.message());
 }
 
+// index.csv, or index.A-B.csv for a range of the input's frames; the same for viz.mp4.
+fs::path range_name(const char* stem, const char* extension, const std::optional<FrameRange>& frames) {
+  return std::string(stem) + (frames ? "." + frames->suffix() : std::string()) + extension;
+}
+
 class Conversion {
  public:
   Conversion(const InputSpec& input, model::FlowSession& session, const ConvertSettings& settings, Progress& progress)
@@ -85,7 +90,7 @@ class Conversion {
         settings_(settings),
         progress_(progress),
         dir_(settings.output_dir / input.output_name),
-        index_(dir_ / kIndexFileName) {}
+        index_(dir_ / range_name("index", ".csv", settings.frames)) {}
 
   void run(InputOutcome& outcome);
   void finish_outputs();
@@ -115,20 +120,35 @@ void Conversion::run(InputOutcome& outcome) {
   if (settings_.viz == VizMode::png) create_folder(dir_ / "viz");
   session_.reset();
 
+  const FrameRange range = settings_.frames.value_or(FrameRange{});
+  const std::int64_t first = range.first;
+  const std::optional<std::int64_t>& end = range.end;
   const auto total_pairs = [&]() -> std::optional<std::int64_t> {
     auto count = frames_->frame_count();
     if (settings_.max_frames > 0) count = count ? std::min(*count, settings_.max_frames) : settings_.max_frames;
     if (!count) return std::nullopt;
-    return std::max<std::int64_t>(*count - 1, 0);
+    std::int64_t pairs = std::max<std::int64_t>(*count - 1, 0);
+    if (end) pairs = std::min(pairs, *end);
+    return std::max<std::int64_t>(pairs - first, 0);
   };
   // The output name is short and unique among the inputs; a full path would crowd the bar out.
   progress_.begin(input_.output_name, total_pairs());
 
+  // A range starts at its first frame: the ones before it are decoded and dropped (the
+  // stream starts afresh there, which gives the same flows as a whole run).
   std::optional<Frame> from = frames_->next();
   if (!from) throw InputError(kExitDataError, input_.label + ": has no frames");
-  progress_.set_total(total_pairs());  // a video's length is known once it plays
   std::int64_t frames_read = 1;
-  while (settings_.max_frames == 0 || frames_read < settings_.max_frames) {
+  while (from && frames_read <= first) {
+    from = frames_->next();
+    ++frames_read;
+  }
+  if (!from) {
+    throw InputError(kExitDataError, input_.label + ": has " + std::to_string(frames_read - 1) +
+                                         " frames; --frames " + settings_.frames->suffix() + " starts after its last");
+  }
+  progress_.set_total(total_pairs());  // a video's length is known once it plays
+  while ((settings_.max_frames == 0 || frames_read < settings_.max_frames) && (!end || frames_read <= *end)) {
     std::optional<Frame> to = frames_->next();
     if (!to) break;
     ++frames_read;
@@ -138,6 +158,10 @@ void Conversion::run(InputOutcome& outcome) {
     }
     convert_pair(*from, *to, outcome);
     from = std::move(to);
+  }
+  if (rows_ == 0 && settings_.frames) {
+    throw InputError(kExitDataError, input_.label + ": --frames " + settings_.frames->suffix() +
+                                         " holds a single frame of it; a flow needs at least two");
   }
   if (rows_ == 0) {
     throw InputError(kExitDataError, input_.label + ": has a single frame; a flow needs at least two");
@@ -165,7 +189,9 @@ void Conversion::convert_pair(const Frame& from, const Frame& to, InputOutcome& 
   const bool write_png = settings_.viz == VizMode::png && !(skipped && complete_png(png_path, width, height));
   render(*field, from.output_stem, write_png);
 
-  index_.add({rows_, from.number, to.number, from.pts_ns, to.pts_ns, file, from.source, to.source});
+  // A row's index is the pair's position in the whole input, so the ranges' indexes add up.
+  const std::int64_t index = rows_ + (settings_.frames ? settings_.frames->first : 0);
+  index_.add({index, from.number, to.number, from.pts_ns, to.pts_ns, file, from.source, to.source});
   ++rows_;
   progress_.pair_done();
 }
@@ -199,7 +225,8 @@ void Conversion::render(const flow::FlowField& field, const std::string& stem, b
   if (!video_) {
     pipeline::FrameRate rate = frames_->frame_rate();
     if (input_.kind != InputKind::video && settings_.image_rate) rate = *settings_.image_rate;
-    video_ = std::make_unique<pipeline::VideoEncoder>(dir_ / "viz.mp4", image.width, image.height,
+    video_ = std::make_unique<pipeline::VideoEncoder>(dir_ / range_name("viz", ".mp4", settings_.frames), image.width,
+                                                      image.height,
                                                       rate.known() ? rate : kImageSequenceRate);
   }
   video_->write(image);
@@ -211,6 +238,10 @@ void Conversion::finish_outputs() {
 }
 
 }  // namespace
+
+std::string FrameRange::suffix() const {
+  return std::to_string(first) + "-" + (end ? std::to_string(*end) : std::string("end"));
+}
 
 InputOutcome convert_input(const InputSpec& input, model::FlowSession& session, const ConvertSettings& settings,
                            Progress& progress) {

@@ -9,10 +9,13 @@
 //                          videos
 //   viz/<stem>.png         its colour rendering (--viz png)
 //   viz.mp4                all renderings as an H.264 video (--viz video)
-//   index.csv              one row per pair (see convert_index.hpp)
+//   index.csv              one row per pair (see convert/index.hpp)
+// With --frames A:B the index and the video are index.A-B.csv and viz.A-B.mp4, so jobs that
+// take other ranges of the same input write beside each other.
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include "convert/input_error.hpp"
 #include "convert/inputs.hpp"
@@ -25,6 +28,15 @@ namespace neuflow::cli {
 
 enum class VizMode { none, png, video };
 
+// The pairs whose first frame is A <= n < B (frames A to B, counted from 0): ranges that meet
+// (0:100, 100:200) share one frame and together hold every pair of the whole input once.
+struct FrameRange {
+  std::int64_t first = 0;
+  std::optional<std::int64_t> end;  // B; unset: to the input's last frame
+  // "A-B" (or "A-end"), for the names of the range's index and video.
+  std::string suffix() const;
+};
+
 struct ConvertSettings {
   std::filesystem::path output_dir;
   flow::FlowFormat format = flow::FlowFormat::flo;
@@ -32,6 +44,7 @@ struct ConvertSettings {
   double max_flow = 20;  // px at full saturation, fixed so colours mean the same in every frame
   bool resume = false;   // keep flow files that exist and read back at the right size
   std::int64_t max_frames = 0;  // 0: every frame; else only the first max_frames of each input
+  std::optional<FrameRange> frames;  // --frames A:B: one range of each input's pairs
   // The rate of viz.mp4 for images (a video keeps its own): unset, the rate the file names'
   // timestamps give, else 10 frames per second.
   std::optional<pipeline::FrameRate> image_rate;
