@@ -856,6 +856,7 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
   gst_element_class_set_static_metadata(element_class, "NeuFlow-V2 optical flow", "Filter/Analyzer/Video",
                                         "Computes optical flow between video frames and attaches it as metadata",
                                         "neuflow");
+  gst_element_class_add_static_metadata(element_class, GST_ELEMENT_METADATA_DOC_URI, NEUFLOW_DOC_URI);
   gst_type_mark_as_plugin_api(channel_order_get_type(), static_cast<GstPluginAPIFlags>(0));
   gst_type_mark_as_plugin_api(behaviour_get_type(), static_cast<GstPluginAPIFlags>(0));
   gst_type_mark_as_plugin_api(backend_get_type(), static_cast<GstPluginAPIFlags>(0));

@@ -252,6 +252,7 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
                                         "Publishes the optical flow attached to video frames (NeuflowFlowMeta) into "
                                         "a POSIX shared-memory ring of the latest flows, for readers in other processes",
                                         "neuflow");
+  gst_element_class_add_static_metadata(element_class, GST_ELEMENT_METADATA_DOC_URI, NEUFLOW_DOC_URI);
   flow_sink_class->start_writing = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_start_writing);
   flow_sink_class->write_flow = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_write_flow);
   flow_sink_class->stop_writing = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_stop_writing);

@@ -573,6 +573,7 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
                                         "Writes the optical flow attached to video frames (NeuflowFlowMeta) to "
                                         "numbered .flo, .npy or KITTI .png files with a CSV index",
                                         "neuflow");
+  gst_element_class_add_static_metadata(element_class, GST_ELEMENT_METADATA_DOC_URI, NEUFLOW_DOC_URI);
   flow_sink_class->start_writing = GST_DEBUG_FUNCPTR(gst_neuflow_sink_start_writing);
   flow_sink_class->write_flow = GST_DEBUG_FUNCPTR(gst_neuflow_sink_write_flow);
   flow_sink_class->stop_writing = GST_DEBUG_FUNCPTR(gst_neuflow_sink_stop_writing);

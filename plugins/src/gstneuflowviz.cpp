@@ -569,6 +569,7 @@ static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
                                         "Draws the optical flow attached to video frames (NeuflowFlowMeta) with the "
                                         "Middlebury colour wheel, as an image or an overlay, optionally with arrows",
                                         "neuflow");
+  gst_element_class_add_static_metadata(element_class, GST_ELEMENT_METADATA_DOC_URI, NEUFLOW_DOC_URI);
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
 

@@ -15,4 +15,4 @@ static gboolean plugin_init(GstPlugin *plugin) {
 #define PACKAGE "neuflow"
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, neuflow,
                   "NeuFlow-V2 optical flow: inference, visualization, flow file and shared-memory output", plugin_init,
-                  NEUFLOW_VERSION, "MIT/X11", "neuflow", "neuflow")
+                  NEUFLOW_VERSION, "MIT/X11", "neuflow", NEUFLOW_ORIGIN_URL)

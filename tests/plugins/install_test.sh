@@ -10,6 +10,10 @@ cmake --install "$build" --prefix "$prefix" > /dev/null
 plugin=$(find "$prefix" -name libgstneuflow.so | head -n 1)
 [ -n "$plugin" ] || { echo "FAIL: libgstneuflow.so not installed under $prefix"; exit 1; }
 echo "installed: $plugin"
+# gst-inspect's Origin URL and Doc-uri point at the documentation installed beside it.
+for doc in README.md LICENSE docs/benchmarks.md; do
+  [ -f "$prefix/share/doc/neuflow/$doc" ] || { echo "FAIL: share/doc/neuflow/$doc not installed"; exit 1; }
+done
 unset GST_PLUGIN_PATH GST_PLUGIN_PATH_1_0
 if ! output=$(GST_PLUGIN_PATH_1_0=$(dirname "$plugin") GST_REGISTRY_1_0="$prefix/registry.bin" "$inspect" neuflow 2>&1) \
     || ! grep -q "iters-s8" <<<"$output"; then
