@@ -4,7 +4,7 @@
 set -euo pipefail
 build=${1:-build/release}
 threads=${2:-2}
-for size in 320x256 512x384 768x432 1024x448; do
+for size in 320x256 512x384 768x432 1024x448 1920x1088; do
   "$build/bench/neuflow-bench-core" --threads "$threads" --sizes "$size" \
     --benchmark_filter='sgemm|pair|stream' --benchmark_counters_tabular=true
 done
