@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <tuple>
 #include <utility>
 #include <stdexcept>
 
@@ -69,16 +71,27 @@ std::vector<float> transform_filters(const ConvWeights& w, const GemmKernel& ker
   return filters;
 }
 
+// FNV-1a over the weights' bytes: with the address, what identifies a layer's weights even if
+// another layer's were once at that address.
+std::uint64_t fingerprint(const ConvWeights& w) {
+  std::uint64_t h = 1469598103934665603ull;
+  const auto* bytes = reinterpret_cast<const unsigned char*>(w.weight.data());
+  for (std::size_t i = 0; i < w.weight.size() * sizeof(float); ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+  return h;
+}
+
 // The transformed filters are 4× the size of the 3×3 weights (~114 MB for the network), so
 // every session of a model shares them, the way sessions share the model: one copy per
-// layer for as long as a plan uses it. A live entry's plan keeps its session's model, and so
-// the weights its key points to, alive.
+// layer for as long as a plan uses it.
 std::shared_ptr<const std::vector<float>> shared_filters(const ConvWeights& w, const GemmKernel& kernel, int depth,
                                                          int columns) {
+  using Key = std::tuple<const float*, std::size_t, std::uint64_t, const GemmKernel*>;
   static std::mutex mutex;
-  static std::map<std::pair<const ConvWeights*, const GemmKernel*>, std::weak_ptr<const std::vector<float>>> cache;
+  static std::map<Key, std::weak_ptr<const std::vector<float>>> cache;
+  const Key key{w.weight.data(), w.weight.size(), fingerprint(w), &kernel};
   const std::lock_guard lock(mutex);
-  auto& entry = cache[{&w, &kernel}];
+  std::erase_if(cache, [](const auto& e) { return e.second.expired(); });  // layers no plan uses
+  auto& entry = cache[key];
   if (auto filters = entry.lock()) return filters;
   auto filters = std::make_shared<const std::vector<float>>(transform_filters(w, kernel, depth, columns));
   entry = filters;
