@@ -44,6 +44,7 @@ FlowSession::FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions 
     : options_(options), model_(std::move(model)), state_(std::make_unique<State>()) {
   if (!model_) throw std::invalid_argument("FlowSession needs a loaded model");
   if (auto problem = check_session_options(options_)) throw std::invalid_argument(*problem);
+  cpu_convolution_from_environment();  // a bad NEUFLOW_CONV fails here, before any frame
   auto& s = *state_;
   if (options_.backend == Backend::vulkan) {
     s.vulkan = open_vulkan(model_, options_.device, options_.precision, s.fallback);

@@ -1,5 +1,9 @@
 #include "neuflow/model/session_settings.hpp"
 
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
 namespace neuflow::model {
 
 namespace {
@@ -90,6 +94,13 @@ std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name) {
   if (name == "direct") return CpuConvolution::direct;
   if (name == "winograd") return CpuConvolution::winograd;
   return std::nullopt;
+}
+
+std::optional<CpuConvolution> cpu_convolution_from_environment() {
+  const char* value = std::getenv("NEUFLOW_CONV");
+  if (!value || !*value) return std::nullopt;
+  if (const auto parsed = parse_cpu_convolution(value)) return parsed;
+  throw std::invalid_argument(std::string("NEUFLOW_CONV: expected auto, direct or winograd, got \"") + value + "\"");
 }
 
 }  // namespace neuflow::model

@@ -2,6 +2,8 @@
 // channel order, clear errors, and one model shared by sessions on several threads.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -159,6 +161,40 @@ TEST_F(SessionTest, UnusableInputsAreRejectedWithAReason) {
   ImageView bad = view_of(frames_[0]);
   bad.stride = 10;
   EXPECT_THROW(session.compute(bad, bad), std::invalid_argument);
+}
+
+// The CPU's two ways of computing the 3×3 convolutions give the same flow to rounding, the
+// environment's NEUFLOW_CONV choosing for sessions that leave it automatic, and a value that
+// is none of the three failing the session at creation with the variable's name.
+TEST_F(SessionTest, DirectAndWinogradConvolutionsGiveTheSameFlow) {
+  const auto flow_with = [&](CpuConvolution c) {
+    FlowSession session(model_, {.threads = 2, .backend = Backend::cpu, .cpu_convolution = c});
+    return session.compute(view_of(frames_[0]), view_of(frames_[1]));
+  };
+  const auto direct = flow_with(CpuConvolution::direct), winograd = flow_with(CpuConvolution::winograd);
+  ASSERT_EQ(direct.uv.size(), winograd.uv.size());
+  double sum = 0, worst = 0;
+  for (std::size_t i = 0; i < direct.uv.size(); ++i) {
+    const double d = std::fabs(direct.uv[i] - winograd.uv[i]);
+    sum += d;
+    worst = std::max(worst, d);
+  }
+  EXPECT_LE(worst, 1e-2) << "px";
+  EXPECT_LE(sum / static_cast<double>(direct.uv.size()), 1e-3) << "px";
+
+  struct Unset {
+    ~Unset() { ::unsetenv("NEUFLOW_CONV"); }
+  } unset;
+  ::setenv("NEUFLOW_CONV", "direct", 1);
+  const auto from_environment = flow_with(CpuConvolution::automatic);
+  EXPECT_EQ(from_environment.uv, direct.uv);
+  ::setenv("NEUFLOW_CONV", "wingrad", 1);
+  try {
+    FlowSession bad(model_, {.threads = 2});
+    ADD_FAILURE() << "a session was created with NEUFLOW_CONV=wingrad";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("NEUFLOW_CONV"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(SessionTest, SessionsOnSeveralThreadsShareOneModel) {

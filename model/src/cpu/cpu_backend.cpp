@@ -34,10 +34,7 @@ class CpuBackend final : public InferenceBackend {
 
 CpuConvolution resolve_cpu_convolution(CpuConvolution requested) {
   if (requested != CpuConvolution::automatic) return requested;
-  const char* env = std::getenv("NEUFLOW_CONV");
-  if (!env || !*env) return requested;
-  if (const auto parsed = parse_cpu_convolution(env)) return *parsed;
-  throw std::invalid_argument(std::string("NEUFLOW_CONV: expected auto, direct or winograd, got \"") + env + "\"");
+  return cpu_convolution_from_environment().value_or(requested);
 }
 
 std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width,

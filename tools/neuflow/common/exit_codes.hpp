@@ -20,6 +20,7 @@ inline constexpr int kExitDataError = 65;   // EX_DATAERR: an input file is malf
 inline constexpr int kExitNoInput = 66;     // EX_NOINPUT: an input file is missing or unreadable
 inline constexpr int kExitUnavailable = 69;  // EX_UNAVAILABLE: the GPU backend (Vulkan, its device) failed
 inline constexpr int kExitCantCreate = 73;  // EX_CANTCREAT: an output could not be written
+inline constexpr int kExitConfig = 78;      // EX_CONFIG: the environment's settings are wrong (NEUFLOW_CONV)
 
 // Thrown from a subcommand's callback: main prints "neuflow <sub>: <message>" and exits
 // with exit_code.

@@ -1,6 +1,7 @@
 #include "common/session_options.hpp"
 
 #include <cstdio>
+#include <stdexcept>
 
 #include "common/exit_codes.hpp"
 
@@ -86,6 +87,11 @@ model::SessionOptions session_options(const SessionArgs& args) {
   options.backend = model::parse_backend(args.backend).value_or(model::Backend::automatic);
   options.precision = model::parse_precision(args.precision).value_or(model::Precision::fp32);
   if (auto problem = model::check_session_options(options)) throw CommandError(kExitUsage, "--" + *problem);
+  try {
+    model::cpu_convolution_from_environment();
+  } catch (const std::invalid_argument& e) {
+    throw CommandError(kExitConfig, e.what());
+  }
   return options;
 }
 

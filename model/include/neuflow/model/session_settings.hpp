@@ -105,4 +105,8 @@ constexpr std::string_view cpu_convolution_name(CpuConvolution c) {
 }
 std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name);  // "auto", "direct", "winograd"
 
+// What the environment's NEUFLOW_CONV asks for, when it is set and not empty; throws
+// std::invalid_argument naming the variable when its value is none of the three.
+std::optional<CpuConvolution> cpu_convolution_from_environment();
+
 }  // namespace neuflow::model
