@@ -1,7 +1,4 @@
 #include <array>
-#include <cstdlib>
-#include <stdexcept>
-#include <string>
 
 #include "dnnl/context.hpp"
 #include "inference_backend.hpp"

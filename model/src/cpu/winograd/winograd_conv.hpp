@@ -47,9 +47,6 @@ class WinogradConv {
   // blocked output's padding channels written as zeros.
   void run(const float* input, const float* addend, float* output) const;
 
-  int tiles() const { return tiles_; }
-  int tiles_per_block() const { return block_tiles_; }
-
  private:
   void transform_inputs(const float* input, int first_tile, int count, float* points) const;
   void transform_outputs(const float* products, int first_tile, int count, const float* addend, float* output) const;
