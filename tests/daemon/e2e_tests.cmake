@@ -3,7 +3,9 @@
 # SIGHUP with a changed config, SIGTERM → exit 0 and a playable MP4, a failing source restarted
 # while another stream keeps producing, a failing sink cut off, config errors with line numbers.
 find_program(NEUFLOW_E2E_PYTHON NAMES python3 HINTS /usr/bin NO_DEFAULT_PATH)
-find_program(GST_LAUNCH gst-launch-1.0 REQUIRED)
+# GStreamer's tools load our plugin, so they are the target's (the arm64 root's in a cross build,
+# run through qemu); CMAKE_FIND_ROOT_PATH is empty in a native build.
+find_program(GST_LAUNCH gst-launch-1.0 REQUIRED ONLY_CMAKE_FIND_ROOT_PATH)
 include(NeuflowGstTestEnv)
 neuflow_gst_test_env(e2e_sanitizer_env)   # neuflowd itself is instrumented under NEUFLOW_SANITIZE
 
