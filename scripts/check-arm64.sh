@@ -32,6 +32,7 @@ work=$(cd "$work" && pwd)
 sysroot="$work/sysroot"
 build="$work/build"
 say() { echo "check-arm64: $*"; }
+sudo=""; if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
 
 # The arm64 packages the build and the tests need: the -dev packages of
 # scripts/install-deps.sh and the GStreamer elements the plugin tests use. Left out: the
@@ -56,7 +57,6 @@ for p in "${host_packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
-  sudo=""; if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
   say "installing ${missing[*]}"
   $sudo apt-get update -q
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
@@ -69,7 +69,8 @@ if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$wanted" ]; then
   say "unpacking the arm64 packages and their dependencies into $sysroot"
   rm -rf "$sysroot"
   start=$(date +%s)
-  mmdebstrap --quiet --variant=extract --mode=root --architectures=arm64 \
+  # root: as root (CI); unshare: as a user, in a user namespace.
+  mmdebstrap --quiet --variant=extract --mode="$([ -z "$sudo" ] && echo root || echo unshare)" --architectures=arm64 \
     --dpkgopt='path-exclude=/usr/share/man/*' --dpkgopt='path-exclude=/usr/share/doc/*' \
     --dpkgopt='path-exclude=/usr/share/locale/*' \
     --include="$(IFS=,; echo "${arm64_packages[*]}")" \
@@ -99,10 +100,10 @@ fi
 # scanner): the kernel hands them to qemu through binfmt_misc. QEMU_LD_PREFIX makes qemu find
 # the root's dynamic loader and libraries first.
 if [ ! -e /proc/sys/fs/binfmt_misc/register ]; then
-  mount -t binfmt_misc binfmt_misc /proc/sys/fs/binfmt_misc 2>/dev/null || true
+  $sudo mount -t binfmt_misc binfmt_misc /proc/sys/fs/binfmt_misc 2>/dev/null || true
 fi
 if [ ! -e /proc/sys/fs/binfmt_misc/qemu-aarch64 ]; then
-  update-binfmts --enable qemu-aarch64 2>/dev/null || true
+  $sudo update-binfmts --enable qemu-aarch64 2>/dev/null || true
 fi
 export QEMU_LD_PREFIX="$sysroot"
 probe="$work/binfmt-probe"
