@@ -130,7 +130,7 @@ file "$build/tools/neuflow" | grep -q "ARM aarch64" || { say "tools/neuflow is n
 # latencies (emulation is 10-50x slower and uneven). Left out unless --all: the tests that take
 # longest under emulation (1-4 min each) and repeat on other sizes or more frames what the
 # parity, streaming and CLI tests below prove (CI's time is short); with --all the run takes
-# about 20 min on 2 cores.
+# about 22 min on 2 cores (460 tests, 2026-12-02).
 always_out='Vulkan|vulkan|LiveRunStaysBounded|WithoutAQueue'
 long_ones='^(flow_command|eval_command|NeuflowElement\.SurvivesManyStateCycles|NeuflowElement\.MetadataEqualsTheCoresFlow'
 long_ones+='|NeuflowElement\.LiveSourceFasterThanInferenceDropsAndKeepsOrder|NeuflowElement\.EveryPairModeOnAFile.*'
