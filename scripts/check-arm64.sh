@@ -52,15 +52,7 @@ arm64_packages=(
 )
 host_packages=(crossbuild-essential-arm64 qemu-user-static binfmt-support mmdebstrap)
 
-missing=()
-for p in "${host_packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  say "installing ${missing[*]}"
-  $sudo apt-get update -q
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
-fi
+bash scripts/install-deps.sh "${host_packages[@]}"
 
 # --- the arm64 root -------------------------------------------------------------------------
 stamp="$sysroot/.neuflow-packages"

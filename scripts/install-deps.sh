@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages that neuflow's build, tests and benchmarks need.
+# Installs the Debian 12 packages that neuflow's build, tests and benchmarks need, or, given
+# package names, those instead (scripts/check-arm64.sh's host tools).
 # Idempotent: does nothing when everything is already installed.
+# Usage: bash scripts/install-deps.sh [PACKAGE...]
 set -euo pipefail
 
 packages=(
@@ -30,6 +32,7 @@ packages=(
   g++-11                            # JetPack 6's compiler: CI compiles the core with it
   python3 python3-numpy             # tests check that numpy reads our .npy files
 )
+if [ $# -gt 0 ]; then packages=("$@"); fi
 
 missing=()
 for p in "${packages[@]}"; do
