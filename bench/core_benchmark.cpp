@@ -5,7 +5,11 @@
 // default (Winograd on the stride-1 3×3 layers), whose `x_direct` is its speed-up over the
 // direct run just before. GFLOP/s always counts the direct convolutions' arithmetic.
 //
-//   neuflow-bench-core [--model CKPT] [--threads N] [--sizes 320x256,768x432] [benchmark flags]
+// With --backend vulkan the GPU runs the same pairs and streams (`x_cpu`: the CPU's time over
+// the GPU's), and `vulkan_stream_stages` splits a streamed frame by the GPU's timestamps.
+//
+//   neuflow-bench-core [--model CKPT] [--threads N] [--sizes 320x256,768x432]
+//                      [--backend cpu|vulkan] [--device N] [benchmark flags]
 //
 // Peak RSS is per process: run one size per process for per-size peaks (bench/run-core.sh).
 #include <benchmark/benchmark.h>
@@ -179,21 +183,26 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
   compare(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), variant);
 }
 
+// The stages the per-stage benchmarks report (refinement iterations summed per scale).
+std::string stage_group(const std::string& name) {
+  if (name.rfind("refine_s8", 0) == 0 || name.rfind("corr_s8", 0) == 0) return "refine_s8";
+  if (name.rfind("refine_s16", 0) == 0 || name.rfind("corr_s16", 0) == 0) return "refine_s16";
+  if (name == "backbone_s16" || name == "backbone_s8" || name == "conv_s8") return "encode";
+  if (name == "merge_s8" || name == "context_merge_s8") return "merge_s8";
+  if (name == "flow") return "upsample";
+  return name;
+}
+
+std::map<std::string, std::map<std::string, double>> g_cpu_stage_ms;  // size → stage → ms
+
 // Where a streamed frame's time goes: the observer is called at the end of each stage, so the
-// time between consecutive calls is the stage's (refinement iterations summed per scale).
+// time between consecutive calls is the stage's.
 void BM_StreamStages(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));
   const auto frames = load_frames(width, height);
   std::map<std::string, double> stage_seconds;
   auto last = std::chrono::steady_clock::now();
-  const auto group = [](const std::string& name) -> std::string {
-    if (name.rfind("refine_s8", 0) == 0 || name.rfind("corr_s8", 0) == 0) return "refine_s8";
-    if (name.rfind("refine_s16", 0) == 0 || name.rfind("corr_s16", 0) == 0) return "refine_s16";
-    if (name == "backbone_s16" || name == "backbone_s8" || name == "conv_s8") return "encode";
-    if (name == "merge_s8" || name == "context_merge_s8") return "merge_s8";
-    if (name == "flow") return "upsample";
-    return name;
-  };
+  const auto group = stage_group;
   session.set_observer([&](const neuflow::model::StageTensor& t) {
     const auto now = std::chrono::steady_clock::now();
     stage_seconds[group(t.name)] += std::chrono::duration<double>(now - last).count();
@@ -208,9 +217,50 @@ void BM_StreamStages(benchmark::State& state, int width, int height, Variant var
     benchmark::DoNotOptimize(f);
     ++i;
   }
+  const std::string size = std::to_string(width) + "x" + std::to_string(height);
   for (const auto& [name, seconds] : stage_seconds) {
-    state.counters[name + "_ms"] = seconds * 1e3 / static_cast<double>(state.iterations());
+    const double ms = seconds * 1e3 / static_cast<double>(state.iterations());
+    state.counters[name + "_ms"] = ms;
+    if (variant.convolution == neuflow::model::CpuConvolution::automatic) g_cpu_stage_ms[size][name] = ms;
   }
+}
+
+// The same on a GPU, from its own timestamps (FlowSession::device_stage_times(), no
+// read-back): each stage's device time, `device_ms` their sum, `host_ms` the whole push as
+// the caller waits for it (upload, submission, read-back and the CPU's frame conversion too),
+// and x_cpu_STAGE the CPU's time for that stage in this run over the GPU's.
+void BM_VulkanStreamStages(benchmark::State& state, int width, int height, Variant variant) {
+  FlowSession session(g_model, options_for(variant));
+  state.SetLabel(session.backend_description());
+  const auto frames = load_frames(width, height);
+  session.push(view(frames[0]));
+  session.push(view(frames[1]));  // warm-up: records the command buffers
+  if (session.device_stage_times().empty()) {
+    state.SkipWithError("this device's compute queue has no timestamps (`neuflow devices`)");
+    return;
+  }
+  std::map<std::string, double> stage_ms;
+  double host_seconds = 0;
+  std::size_t i = 2;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto f = session.push(view(frames[i % frames.size()]));
+    host_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    benchmark::DoNotOptimize(f);
+    for (const auto& t : session.device_stage_times()) stage_ms[stage_group(t.name)] += t.milliseconds;
+    ++i;
+  }
+  const double n = static_cast<double>(state.iterations());
+  const auto& cpu = g_cpu_stage_ms[std::to_string(width) + "x" + std::to_string(height)];
+  double device_ms = 0;
+  for (const auto& [name, total] : stage_ms) {
+    const double ms = total / n;
+    device_ms += ms;
+    state.counters[name + "_ms"] = ms;
+    if (const auto it = cpu.find(name); it != cpu.end() && ms > 0) state.counters["x_cpu_" + name] = it->second / ms;
+  }
+  state.counters["device_ms"] = device_ms;
+  state.counters["host_ms"] = host_seconds * 1e3 / n;
 }
 
 // Our own options are taken out of argv before Google Benchmark sees the rest.
@@ -306,6 +356,11 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("stream_stages/" + size).c_str(), BM_StreamStages, w, h, cpu)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(3);
+    if (g_config.vulkan) {
+      benchmark::RegisterBenchmark(("vulkan_stream_stages/" + size).c_str(), BM_VulkanStreamStages, w, h, vulkan)
+          ->Unit(benchmark::kMillisecond)
+          ->Iterations(3);
+    }
   }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 64;

@@ -23,6 +23,7 @@ struct FlowSession::State {
   int previous_slot = 0;
   bool has_previous = false;
   StageObserver observer;
+  std::vector<StageTime> stage_times;  // of the last compute() or push()
 };
 
 namespace {
@@ -71,6 +72,7 @@ void FlowSession::reset() { state_->has_previous = false; }
 
 const std::string& FlowSession::backend_description() const { return state_->description; }
 const std::string& FlowSession::fallback_warning() const { return state_->fallback; }
+const std::vector<StageTime>& FlowSession::device_stage_times() const { return state_->stage_times; }
 
 namespace {
 
@@ -105,6 +107,12 @@ const FrameGeometry& prepare_plan(FlowSession::State& s, const FlowModel& model,
   return s.geometry;
 }
 
+// A call with an observer reads every stage back, so its times are not the network's.
+void keep_stage_times(FlowSession::State& s) {
+  s.stage_times = s.backend->take_stage_times();
+  if (s.observer) s.stage_times.clear();
+}
+
 }  // namespace
 
 flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& frame1) {
@@ -119,12 +127,15 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   apply_threads(options_.threads);
   auto& s = *state_;
   const FrameGeometry& g = prepare_plan(s, *model_, options_, frame0.width, frame0.height);
+  s.stage_times.clear();
+  s.backend->take_stage_times();  // what a call that failed half-way left
   const auto [first, second] = free_slots(s.previous_slot);
   prepare_input(frame0, g, options_.network_order, s.input);
   s.backend->encode(s.input, first);
   prepare_input(frame1, g, options_.network_order, s.input);
   s.backend->encode(s.input, second);
   s.backend->flow(first, second, iterations, s.model_flow, &s.observer);
+  keep_stage_times(s);
   return restore_flow(s.model_flow, g);
 }
 
@@ -135,6 +146,8 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   apply_threads(options_.threads);
   auto& s = *state_;
   const FrameGeometry& g = prepare_plan(s, *model_, options_, frame.width, frame.height);
+  s.stage_times.clear();
+  s.backend->take_stage_times();
   // A stream alternates between slots 0 and 1, so the third (what compute() takes while a
   // stream is open) holds no features unless compute() is used: 48 MB at 1920×1088 on the CPU.
   const int current = s.previous_slot == 0 ? 1 : 0;
@@ -145,6 +158,7 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
     s.backend->flow(s.previous_slot, current, iterations, s.model_flow, &s.observer);
     result = restore_flow(s.model_flow, g);
   }
+  keep_stage_times(s);
   s.previous_slot = current;
   s.has_previous = true;
   return result;

@@ -5,6 +5,7 @@
 // encoded once, serving two pairs) and compute pairs without disturbing the stream.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/session_settings.hpp"
@@ -28,6 +29,9 @@ class InferenceBackend {
   // observer, when set, sees every named stage (the same names on every backend).
   virtual void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,
                     const StageObserver* observer) = 0;
+  // The device's own time for each stage of the passes since the last call, where the backend
+  // measures one (the GPU's timestamps); the CPU's stages are timed with an observer instead.
+  virtual std::vector<StageTime> take_stage_times() { return {}; }
 };
 
 // `convolution` automatic defers to NEUFLOW_CONV (auto, direct or winograd) when it is set.

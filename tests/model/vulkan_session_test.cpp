@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -209,6 +210,55 @@ TEST_F(VulkanSession, Fp16StaysWithinItsBoundOfFp32) {
     EXPECT_LT(epe, 0.005 * magnitude) << w << "x" << h;
     EXPECT_LT(worst, 0.01 * largest) << w << "x" << h;
   }
+}
+
+// What neuflow-bench-core's vulkan_stream_stages prints: the GPU's own time of each stage of
+// a streamed frame, named as the observer's stages (a refinement iteration as one), in the
+// order they ran, adding up to no more than the host's time for the whole push.
+TEST_F(VulkanSession, DeviceTimestampsTimeEveryStageOfAFrame) {
+  if (!list_gpu_devices().at(0).timestamps) GTEST_SKIP() << "Vulkan device 0 has no timestamps on its compute queue";
+  const Iterations iterations{1, 2};
+  FlowSession gpu(model_, {.iterations = iterations, .backend = Backend::vulkan, .device = 0});
+  // The flow pass's stages as the observer sees them, less the backbone's (which that pass
+  // reads, not computes) and with an iteration's corr_/hidden/delta tensors as one stage.
+  std::vector<std::string> flow_stages;
+  gpu.set_observer([&](const StageTensor& t) {
+    std::string name = t.name;
+    if (name.rfind("backbone_", 0) == 0 || name == "conv_s8") return;
+    if (name.rfind("corr_", 0) == 0) name = "refine_" + name.substr(5);
+    if (name.size() > 7 && (name.ends_with("_hidden") || name.ends_with("_delta"))) return;
+    if (flow_stages.empty() || flow_stages.back() != name) flow_stages.push_back(name);
+  });
+  gpu.push(view_of(frames_[0]));
+  EXPECT_TRUE(gpu.device_stage_times().empty()) << "an observed pass is not timed";
+  gpu.push(view_of(frames_[1]));
+  gpu.set_observer(nullptr);
+
+  gpu.push(view_of(frames_[0]));
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(gpu.push(view_of(frames_[1])).has_value());
+  const double host_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const auto& times = gpu.device_stage_times();
+  std::vector<std::string> timed;
+  double device_ms = 0;
+  for (const auto& t : times) {
+    timed.push_back(t.name);
+    EXPECT_GE(t.milliseconds, 0) << t.name;
+    device_ms += t.milliseconds;
+  }
+  // A streamed frame encodes one frame, then runs the flow pass.
+  std::vector<std::string> expected{"backbone_s8", "backbone_s16", "conv_s8"};
+  expected.insert(expected.end(), flow_stages.begin(), flow_stages.end());
+  EXPECT_EQ(timed, expected);
+  // attention, matching, one 1/16 iteration, two merges, two 1/8 iterations, the upsampled flow
+  EXPECT_EQ(flow_stages.size(), 1u + 1 + 1 + 2 + 2 + 1);
+  EXPECT_GT(device_ms, 0);
+  EXPECT_LE(device_ms, host_ms * 1.01 + 0.1);
+
+  FlowSession cpu(model_, {.iterations = iterations, .backend = Backend::cpu});
+  cpu.push(view_of(frames_[0]));
+  cpu.push(view_of(frames_[1]));
+  EXPECT_TRUE(cpu.device_stage_times().empty());
 }
 
 TEST(VulkanDevices, EachDeviceHasANameTypeAndMemory) {

@@ -22,6 +22,7 @@ class VulkanBackend final : public InferenceBackend {
   void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer) override {
     network_.flow(slot0, slot1, iterations, out, observer);
   }
+  std::vector<StageTime> take_stage_times() override { return network_.take_stage_times(); }
 
  private:
   std::shared_ptr<VulkanContext> context_;

@@ -94,10 +94,15 @@ VulkanDevice::VulkanDevice(VkPhysicalDevice physical, int index)
   for (uint32_t f = 0; f < families && !found; ++f) {
     if (family[f].queueFlags & VK_QUEUE_COMPUTE_BIT) {
       queue_family_ = f;
+      timestamp_bits_ = family[f].timestampValidBits;
       found = true;
     }
   }
   if (!found) throw BackendError(BackendError::Kind::unavailable, label_ + ": has no compute queue");
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(physical_, &props);
+  timestamp_period_ns_ = props.limits.timestampPeriod;
+  if (timestamp_period_ns_ <= 0) timestamp_bits_ = 0;
 
   const float priority = 1.f;
   VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};

@@ -56,6 +56,10 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   const std::string& label() const { return label_; }
   VkDevice handle() const { return device_; }
   uint32_t queue_family() const { return queue_family_; }
+  // Timestamp queries on the compute queue: the counter's valid bits (0: none) and the
+  // nanoseconds per tick.
+  uint32_t timestamp_bits() const { return timestamp_bits_; }
+  double timestamp_period_ns() const { return timestamp_period_ns_; }
   // The fp16 variants are created on first use (info().fp16 devices only).
   VkPipeline pipeline(Shader shader, bool fp16);
   VkPipelineLayout pipeline_layout() const { return pipeline_layout_; }
@@ -93,6 +97,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
+  uint32_t timestamp_bits_ = 0;
+  double timestamp_period_ns_ = 0;
   VkPhysicalDeviceMemoryProperties memory_{};
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <mutex>
 #include <string>
+#include <vector>
 
 namespace neuflow::model::vulkan {
 
@@ -158,6 +159,17 @@ GpuDevice describe(VkPhysicalDevice device, int index) {
   }
   d.max_buffer_bytes = props.limits.maxStorageBufferRange;
   d.fp16 = vulkan12 && f16.shaderFloat16 && storage16.storageBuffer16BitAccess;
+  // The queue family VulkanDevice takes: the first with compute.
+  uint32_t families = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &families, nullptr);
+  std::vector<VkQueueFamilyProperties> family(families);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &families, family.data());
+  for (const auto& f : family) {
+    if (f.queueFlags & VK_QUEUE_COMPUTE_BIT) {
+      d.timestamps = f.timestampValidBits > 0 && props.limits.timestampPeriod > 0;
+      break;
+    }
+  }
   return d;
 }
 

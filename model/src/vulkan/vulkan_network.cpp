@@ -56,9 +56,29 @@ uint32_t tiles(long count, const char* what) {
 // a fresh recording.
 class VulkanNetwork::Recorder {
  public:
-  Recorder(VulkanNetwork& net, VkCommandBuffer commands, const StageObserver* observer)
-      : net_(net), commands_(commands), observer_(observer && *observer ? observer : nullptr) {
+  // marks: where the stages' timestamps go (nullptr: not timed, as with an observer).
+  Recorder(VulkanNetwork& net, VkCommandBuffer commands, const StageObserver* observer,
+           std::vector<std::string>* marks = nullptr)
+      : net_(net),
+        commands_(commands),
+        observer_(observer && *observer ? observer : nullptr),
+        marks_(observer_ || net.timestamps_ == VK_NULL_HANDLE ? nullptr : marks) {
     begin();
+    if (marks_) {
+      vkCmdResetQueryPool(commands_, net_.timestamps_, 0, kTimestamps);
+      vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_, 0);
+    }
+  }
+
+  // The end of the stage `name`: a timestamp once everything recorded before it has run.
+  // Consecutive names without work between them (the backbone's outputs that the flow pass
+  // only reads) take no timestamp.
+  void mark(const std::string& name) {
+    if (!marks_ || !worked_ || marks_->size() + 1 >= kTimestamps) return;
+    marks_->push_back(name);
+    vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_,
+                        static_cast<uint32_t>(marks_->size()));
+    worked_ = false;
   }
 
   void begin() {
@@ -82,6 +102,7 @@ class VulkanNetwork::Recorder {
   }
 
   void barrier() {
+    worked_ = true;  // every command is recorded after its barrier
     VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
     b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
@@ -176,7 +197,10 @@ class VulkanNetwork::Recorder {
 
   // Reads `v` back and hands it to the observer as NHWC (only when observing).
   void observe(const std::string& name, int frame, const View& v) {
-    if (!observer_) return;
+    if (!observer_) {
+      mark(name);
+      return;
+    }
     barrier();
     const VkDeviceSize e = net_.elem_;
     const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
@@ -200,6 +224,8 @@ class VulkanNetwork::Recorder {
   VulkanNetwork& net_;
   VkCommandBuffer commands_;
   const StageObserver* observer_;
+  std::vector<std::string>* marks_;
+  bool worked_ = false;  // commands recorded since the last timestamp
   std::vector<float> nhwc_;
 };
 
@@ -283,6 +309,12 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
     device_.check(vkCreateCommandPool(device_.handle(), &pool, nullptr, &pool_), "vkCreateCommandPool");
     VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     device_.check(vkCreateFence(device_.handle(), &fence, nullptr, &fence_), "vkCreateFence");
+    if (device_.timestamp_bits() > 0) {
+      VkQueryPoolCreateInfo queries{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+      queries.queryType = VK_QUERY_TYPE_TIMESTAMP;
+      queries.queryCount = kTimestamps;
+      device_.check(vkCreateQueryPool(device_.handle(), &queries, nullptr, &timestamps_), "vkCreateQueryPool");
+    }
     initialise_constants();
   } catch (...) {
     release_handles();
@@ -294,9 +326,11 @@ VulkanNetwork::~VulkanNetwork() { release_handles(); }
 
 void VulkanNetwork::release_handles() {
   VkDevice d = device_.handle();
+  if (timestamps_ != VK_NULL_HANDLE) vkDestroyQueryPool(d, timestamps_, nullptr);
   if (fence_ != VK_NULL_HANDLE) vkDestroyFence(d, fence_, nullptr);
   if (pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(d, pool_, nullptr);  // frees its command buffers
   for (VkDescriptorPool p : descriptor_pools_) vkDestroyDescriptorPool(d, p, nullptr);
+  timestamps_ = VK_NULL_HANDLE;
   fence_ = VK_NULL_HANDLE;
   pool_ = VK_NULL_HANDLE;
   descriptor_pools_.clear();
@@ -406,11 +440,12 @@ VkCommandBuffer allocate_commands(VulkanDevice& device, VkCommandPool pool) {
 }
 }  // namespace
 
-VkCommandBuffer VulkanNetwork::cached(const std::string& key, int slot0, int slot1, const Iterations* iterations) {
+const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, int slot0, int slot1,
+                                                 const Iterations* iterations) {
   if (auto it = command_buffers_.find(key); it != command_buffers_.end()) return it->second;
-  VkCommandBuffer cb = allocate_commands(device_, pool_);
+  Pass pass{allocate_commands(device_, pool_), {}};
   try {
-    Recorder r(*this, cb, nullptr);
+    Recorder r(*this, pass.commands, nullptr, &pass.marks);
     if (iterations) {
       record_flow(r, slot0, slot1, *iterations);
     } else {
@@ -418,11 +453,29 @@ VkCommandBuffer VulkanNetwork::cached(const std::string& key, int slot0, int slo
     }
     r.end();
   } catch (...) {
-    vkFreeCommandBuffers(device_.handle(), pool_, 1, &cb);
+    vkFreeCommandBuffers(device_.handle(), pool_, 1, &pass.commands);
     throw;
   }
-  command_buffers_.emplace(key, cb);
-  return cb;
+  return command_buffers_.emplace(key, std::move(pass)).first->second;
+}
+
+// Runs a recorded pass and reads its timestamps: each stage's time is the difference to the
+// timestamp before it, on a counter of timestamp_bits() bits that may wrap.
+void VulkanNetwork::run(const Pass& pass) {
+  device_.submit_and_wait(pass.commands, fence_);
+  if (pass.marks.empty()) return;
+  const auto count = static_cast<uint32_t>(pass.marks.size() + 1);
+  timestamp_values_.resize(count);
+  device_.check(vkGetQueryPoolResults(device_.handle(), timestamps_, 0, count, count * sizeof(uint64_t),
+                                      timestamp_values_.data(), sizeof(uint64_t),
+                                      VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                "vkGetQueryPoolResults");
+  const uint32_t bits = device_.timestamp_bits();
+  const uint64_t mask = bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1;
+  for (std::size_t i = 0; i < pass.marks.size(); ++i) {
+    const uint64_t ticks = (timestamp_values_[i + 1] - timestamp_values_[i]) & mask;
+    stage_times_.push_back({pass.marks[i], static_cast<double>(ticks) * device_.timestamp_period_ns() * 1e-6});
+  }
 }
 
 void VulkanNetwork::encode(const Tensor& image, int slot) {
@@ -436,7 +489,7 @@ void VulkanNetwork::encode(const Tensor& image, int slot) {
     dst[2 * hw + p] = image.data[3 * p + 2];
   }
   store(staging_.data(), staging_.size(), upload_.mapped());
-  device_.submit_and_wait(cached("encode" + std::to_string(slot), slot, 0, nullptr), fence_);
+  run(cached("encode" + std::to_string(slot), slot, 0, nullptr));
 }
 
 void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,
@@ -449,7 +502,7 @@ void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Ten
   } else {
     const std::string key = "flow" + std::to_string(slot0) + std::to_string(slot1) + ":" +
                             std::to_string(iterations.s16) + ":" + std::to_string(iterations.s8);
-    device_.submit_and_wait(cached(key, slot0, slot1, &iterations), fence_);
+    run(cached(key, slot0, slot1, &iterations));
   }
   out.resize(height_, width_, 2);
   const std::size_t hw = static_cast<std::size_t>(height_) * width_;
@@ -482,11 +535,14 @@ void VulkanNetwork::record_encode(Recorder& r, int slot) {
   block(wt.block_8_1, half, 4, 2, cat8.channels(0, 256));
   block(wt.block_8_2, quarter, 2, 2, cat8.channels(256, 128));
   block(wt.block_cat_8, cat8, 1, 1, f8);
+  r.mark("backbone_s8");
   const View cat16{&cat16_, 0, 256, h16_, w16_};
   block(wt.block_16_1, eighth, 2, 2, cat16.channels(0, 128));
   block(wt.block_8_16, f8, 2, 2, cat16.channels(128, 128));
   block(wt.block_cat_16, cat16, 1, 1, View{&s.f16, 0, 190, h16_, w16_});
+  r.mark("backbone_s16");
   block(wt.conv_s8, input, 8, 0, View{&s.up, 0, 128, h8_, w8_});
+  r.mark("conv_s8");
 }
 
 void VulkanNetwork::record_attention_layer(Recorder& r, const DeviceAttentionLayer& w, const Buffer& src,
@@ -552,8 +608,10 @@ void VulkanNetwork::record_refinement(Recorder& r, const DeviceRefine& w, Refine
     } up{h * wd, input.channels(kHiddenOffset, 1).offset(), input.channels(kFlowOffset, 1).offset(), flow.offset()};
     r.dispatch(Shader::refine_update, {&b.out66, nullptr, &b.input, flow.buffer}, &up, sizeof up,
                groups(static_cast<long>(h) * wd, kLocal));
-    if (r.observing()) {
-      const std::string it = "_iter" + std::to_string(i);
+    const std::string it = "_iter" + std::to_string(i);
+    if (!r.observing()) {
+      r.mark("refine_" + scale + it);  // the observer's three tensors of an iteration are read at its end
+    } else {
       r.observe("corr_" + scale + it, 0, input.channels(0, kCorr));
       r.observe("refine_" + scale + it + "_hidden", 0, input.channels(kHiddenOffset, kHidden));
       r.observe("refine_" + scale + it + "_delta", 0, out66.channels(0, 2));
@@ -650,6 +708,7 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
              groups(static_cast<long>(height_) * width_, kLocal));
   r.copy_raw(flow_full_, readback_, static_cast<std::size_t>(2) * height_ * width_);
   r.host_barrier();
+  r.mark("flow");
 }
 
 }  // namespace neuflow::model::vulkan

@@ -3,11 +3,14 @@
 // set and command buffer is created once here; a pass replays a command buffer recorded the
 // first time that pass (encode into a slot, or flow between two slots with given iterations)
 // was asked for. With an observer the pass is recorded anew, stopping at every named stage to
-// read it back.
+// read it back. Without one, a recorded pass writes a GPU timestamp after each named stage
+// (where the queue has timestamps), so every pass also measures where its time went.
 #include <array>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "neuflow/model/session_settings.hpp"
@@ -44,6 +47,9 @@ class VulkanNetwork {
   void encode(const Tensor& image, int slot);
   // out: [height, width, 2] NHWC.
   void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer);
+  // The device time of each named stage of the passes run since the last call (none for a
+  // pass with an observer, or on a queue without timestamps).
+  std::vector<StageTime> take_stage_times() { return std::exchange(stage_times_, {}); }
 
   class Recorder;
 
@@ -54,13 +60,20 @@ class VulkanNetwork {
   struct Refine {
     Buffer input, constant_in, constant_out, xa, xb, out66;
   };
+  // A recorded pass: the stage after which each of its timestamps 1.. is written (0: its start).
+  struct Pass {
+    VkCommandBuffer commands = VK_NULL_HANDLE;
+    std::vector<std::string> marks;
+  };
+  static constexpr uint32_t kTimestamps = 1024;  // per pass; stages past it are not timed
   void record_encode(Recorder& r, int slot);
   void record_flow(Recorder& r, int slot0, int slot1, const Iterations& iterations);
   void record_attention_layer(Recorder& r, const DeviceAttentionLayer& w, const Buffer& src, const Buffer& tgt,
                               const Buffer& out);
   void record_refinement(Recorder& r, const DeviceRefine& w, Refine& buffers, const View& f0, const View& f1,
                          const View& flow, int iterations, const std::string& scale);
-  VkCommandBuffer cached(const std::string& key, int slot0, int slot1, const Iterations* iterations);
+  const Pass& cached(const std::string& key, int slot0, int slot1, const Iterations* iterations);
+  void run(const Pass& pass);
   VkDescriptorSet descriptor_set(const std::array<VkBuffer, 4>& buffers);
   void initialise_constants();
   void release_handles();
@@ -90,7 +103,10 @@ class VulkanNetwork {
   VkFence fence_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorPool> descriptor_pools_;
   std::map<std::array<VkBuffer, 4>, VkDescriptorSet> descriptor_sets_;
-  std::map<std::string, VkCommandBuffer> command_buffers_;
+  std::map<std::string, Pass> command_buffers_;
+  VkQueryPool timestamps_ = VK_NULL_HANDLE;
+  std::vector<uint64_t> timestamp_values_;
+  std::vector<StageTime> stage_times_;
   VkCommandBuffer observed_commands_ = VK_NULL_HANDLE;
 };
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/model/flow_model.hpp"
@@ -58,6 +59,12 @@ class FlowSession {
   // What the session does other than asked, once: backend=auto leaving a GPU it found for the
   // CPU, or fp16 on a device without it running fp32. Empty otherwise. Callers report it once.
   const std::string& fallback_warning() const;
+
+  // Where the last compute() or push() spent its time on a GPU, measured by the device's own
+  // timestamps (not the host's clock, so without submission and read-back): each stage in the
+  // order it ran, the frames' encodings first. Empty on the CPU backend (time its stages with
+  // an observer), while an observer is set, and on a device whose queue has no timestamps.
+  const std::vector<StageTime>& device_stage_times() const;
 
   struct State;  // opaque per-session buffers and stream state
 

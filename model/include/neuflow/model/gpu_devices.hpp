@@ -33,6 +33,7 @@ struct GpuDevice {
   std::uint64_t memory_bytes = 0;  // device-local heaps
   std::uint64_t max_buffer_bytes = 0;  // maxStorageBufferRange
   bool fp16 = false;         // shaderFloat16 and 16-bit storage
+  bool timestamps = false;   // its compute queue has timestamps: FlowSession::device_stage_times()
   bool is_gpu() const { return type == "discrete" || type == "integrated"; }
 };
 

@@ -18,4 +18,13 @@ struct StageTensor {
 
 using StageObserver = std::function<void(const StageTensor&)>;
 
+// How long a stage ran on the device, from the GPU's own timestamps (FlowSession::
+// device_stage_times()). Named as the observer's stages, except that a refinement iteration is
+// one stage ("refine_s8_iter0"); each runs from the end of the stage before it ("backbone_s8"
+// of a frame's encoding from the frame's upload, "merge_s8" includes resampling the flow to 1/8).
+struct StageTime {
+  std::string name;
+  double milliseconds;
+};
+
 }  // namespace neuflow::model
