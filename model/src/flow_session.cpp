@@ -107,6 +107,14 @@ const FrameGeometry& prepare_plan(FlowSession::State& s, const FlowModel& model,
   return s.geometry;
 }
 
+// The backend converts the frame itself where it can (a GPU: from the 8-bit pixels, a quarter
+// of the bytes to upload), else it is converted here.
+void encode(FlowSession::State& s, const ImageView& frame, const FrameGeometry& g, ChannelOrder order, int slot) {
+  if (s.backend->encode_frame(frame, g, order, slot)) return;
+  prepare_input(frame, g, order, s.input);
+  s.backend->encode(s.input, slot);
+}
+
 // A call with an observer reads every stage back, so its times are not the network's.
 void keep_stage_times(FlowSession::State& s) {
   s.stage_times = s.backend->take_stage_times();
@@ -130,10 +138,10 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   s.stage_times.clear();
   s.backend->take_stage_times();  // what a call that failed half-way left
   const auto [first, second] = free_slots(s.previous_slot);
-  prepare_input(frame0, g, options_.network_order, s.input);
-  s.backend->encode(s.input, first);
-  prepare_input(frame1, g, options_.network_order, s.input);
-  s.backend->encode(s.input, second);
+  check_image(frame0, g);
+  check_image(frame1, g);
+  encode(s, frame0, g, options_.network_order, first);
+  encode(s, frame1, g, options_.network_order, second);
   s.backend->flow(first, second, iterations, s.model_flow, &s.observer);
   keep_stage_times(s);
   return restore_flow(s.model_flow, g);
@@ -151,8 +159,8 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   // A stream alternates between slots 0 and 1, so the third (what compute() takes while a
   // stream is open) holds no features unless compute() is used: 48 MB at 1920×1088 on the CPU.
   const int current = s.previous_slot == 0 ? 1 : 0;
-  prepare_input(frame, g, options_.network_order, s.input);
-  s.backend->encode(s.input, current);
+  check_image(frame, g);
+  encode(s, frame, g, options_.network_order, current);
   std::optional<flow::FlowField> result;
   if (s.has_previous) {
     s.backend->flow(s.previous_slot, current, iterations, s.model_flow, &s.observer);

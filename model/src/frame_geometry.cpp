@@ -32,11 +32,15 @@ FrameGeometry plan_geometry(int input_width, int input_height, const SessionOpti
   return g;
 }
 
-void prepare_input(const ImageView& image, const FrameGeometry& g, ChannelOrder network_order, Tensor& out) {
+void check_image(const ImageView& image, const FrameGeometry& g) {
   if (image.data == nullptr || image.width != g.input_width || image.height != g.input_height ||
       image.stride < static_cast<std::ptrdiff_t>(image.width) * 3) {
     throw std::invalid_argument("image does not match the session's frame size or has a short row stride");
   }
+}
+
+void prepare_input(const ImageView& image, const FrameGeometry& g, ChannelOrder network_order, Tensor& out) {
+  check_image(image, g);
   const cv::Mat src(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.data),
                     static_cast<std::size_t>(image.stride));
   cv::Mat ordered;

@@ -19,6 +19,10 @@ struct FrameGeometry {
 // Throws std::invalid_argument when the size is below 32×32 or the model size is unusable.
 FrameGeometry plan_geometry(int input_width, int input_height, const SessionOptions& options);
 
+// Throws std::invalid_argument when the image is not of the geometry's input size or its
+// row stride is short.
+void check_image(const ImageView& image, const FrameGeometry& geometry);
+
 // The frame as the network's input: [model_height, model_width, 3] in 0..1, its channels in
 // `network_order` whatever order the image holds.
 void prepare_input(const ImageView& image, const FrameGeometry& geometry, ChannelOrder network_order, Tensor& out);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "frame_geometry.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
@@ -25,6 +26,13 @@ class InferenceBackend {
 
   // image: [height, width, 3] in 0..1, in the network's channel order.
   virtual void encode(const Tensor& image, int slot) = 0;
+  // The frame from its 8-bit pixels, converted by the backend itself (as prepare_input() would:
+  // the image is checked already). False where the backend leaves that to the session, which
+  // then converts on the CPU and calls encode().
+  virtual bool encode_frame(const ImageView& /*image*/, const FrameGeometry& /*geometry*/,
+                            ChannelOrder /*network_order*/, int /*slot*/) {
+    return false;
+  }
   // Flow from the frame in slot0 to the frame in slot1: [height, width, 2] (u, v). The
   // observer, when set, sees every named stage (the same names on every backend).
   virtual void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,

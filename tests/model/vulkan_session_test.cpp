@@ -128,6 +128,47 @@ TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {
   EXPECT_GT(compare(p01, p12).max, 1e-3) << "different pairs should give different flows";
 }
 
+// In padding mode the device converts the frame from its 8-bit pixels (frame_u8.comp): at an
+// odd offset in its padding, in either channel order, with a row stride longer than the row;
+// a resize is converted on the CPU. Each gives the CPU backend's flow.
+TEST_F(VulkanSession, FramesConvertedOnTheDeviceGiveTheCpusFlow) {
+  cv::Mat bgr0, bgr1;
+  cv::resize(frames_[0], bgr0, cv::Size(100, 60), 0, 0, cv::INTER_AREA);  // → 112×64, padded 6 left, 2 top
+  cv::resize(frames_[1], bgr1, cv::Size(100, 60), 0, 0, cv::INTER_AREA);
+  const SessionOptions gpu_options{.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0};
+  const SessionOptions cpu_options{.iterations = {1, 1}, .threads = 2, .backend = Backend::cpu};
+  FlowSession gpu(model_, gpu_options), cpu(model_, cpu_options);
+  const auto expected = cpu.compute(view_of(bgr0), view_of(bgr1));
+  const auto from_bgr = gpu.compute(view_of(bgr0), view_of(bgr1));
+  Errors e = compare(from_bgr, expected);
+  EXPECT_LT(e.max, 1e-2);
+  EXPECT_LT(e.mean, 1e-3);
+
+  cv::Mat rgb0, rgb1;
+  cv::cvtColor(bgr0, rgb0, cv::COLOR_BGR2RGB);
+  cv::cvtColor(bgr1, rgb1, cv::COLOR_BGR2RGB);
+  ImageView v0 = view_of(rgb0), v1 = view_of(rgb1);
+  v0.order = v1.order = ChannelOrder::rgb;
+  EXPECT_EQ(compare(gpu.compute(v0, v1), from_bgr).max, 0) << "the same pixels in the other channel order";
+
+  cv::Mat wide0(60, 130, CV_8UC3, cv::Scalar(0, 0, 255)), wide1 = wide0.clone();
+  bgr0.copyTo(wide0(cv::Rect(17, 0, 100, 60)));
+  bgr1.copyTo(wide1(cv::Rect(17, 0, 100, 60)));
+  EXPECT_EQ(compare(gpu.compute(view_of(wide0(cv::Rect(17, 0, 100, 60))), view_of(wide1(cv::Rect(17, 0, 100, 60)))),
+                    from_bgr)
+                .max,
+            0)
+      << "rows read at their stride";
+
+  SessionOptions resized_gpu = gpu_options, resized_cpu = cpu_options;
+  resized_gpu.model_width = resized_cpu.model_width = 96;
+  resized_gpu.model_height = resized_cpu.model_height = 64;
+  FlowSession gpu_resize(model_, resized_gpu), cpu_resize(model_, resized_cpu);
+  e = compare(gpu_resize.compute(view_of(bgr0), view_of(bgr1)), cpu_resize.compute(view_of(bgr0), view_of(bgr1)));
+  EXPECT_LT(e.max, 1e-2);
+  EXPECT_LT(e.mean, 1e-3);
+}
+
 TEST_F(VulkanSession, ADeviceThatDoesNotExistIsAnErrorNamingIt) {
   try {
     FlowSession session(model_, {.backend = Backend::vulkan, .device = 63});
@@ -219,6 +260,9 @@ TEST_F(VulkanSession, DeviceTimestampsTimeEveryStageOfAFrame) {
   if (!list_gpu_devices().at(0).timestamps) GTEST_SKIP() << "Vulkan device 0 has no timestamps on its compute queue";
   const Iterations iterations{1, 2};
   FlowSession gpu(model_, {.iterations = iterations, .backend = Backend::vulkan, .device = 0});
+  cv::Mat f0, f1;  // small: the stages' names and order are the same at any size
+  cv::resize(frames_[0], f0, cv::Size(96, 64), 0, 0, cv::INTER_AREA);
+  cv::resize(frames_[1], f1, cv::Size(96, 64), 0, 0, cv::INTER_AREA);
   // The flow pass's stages as the observer sees them, less the backbone's (which that pass
   // reads, not computes) and with an iteration's corr_/hidden/delta tensors as one stage.
   std::vector<std::string> flow_stages;
@@ -229,14 +273,14 @@ TEST_F(VulkanSession, DeviceTimestampsTimeEveryStageOfAFrame) {
     if (name.size() > 7 && (name.ends_with("_hidden") || name.ends_with("_delta"))) return;
     if (flow_stages.empty() || flow_stages.back() != name) flow_stages.push_back(name);
   });
-  gpu.push(view_of(frames_[0]));
+  gpu.push(view_of(f0));
   EXPECT_TRUE(gpu.device_stage_times().empty()) << "an observed pass is not timed";
-  gpu.push(view_of(frames_[1]));
+  gpu.push(view_of(f1));
   gpu.set_observer(nullptr);
 
-  gpu.push(view_of(frames_[0]));
+  gpu.push(view_of(f0));
   const auto t0 = std::chrono::steady_clock::now();
-  ASSERT_TRUE(gpu.push(view_of(frames_[1])).has_value());
+  ASSERT_TRUE(gpu.push(view_of(f1)).has_value());
   const double host_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const auto& times = gpu.device_stage_times();
   std::vector<std::string> timed;
@@ -256,8 +300,8 @@ TEST_F(VulkanSession, DeviceTimestampsTimeEveryStageOfAFrame) {
   EXPECT_LE(device_ms, host_ms * 1.01 + 0.1);
 
   FlowSession cpu(model_, {.iterations = iterations, .backend = Backend::cpu});
-  cpu.push(view_of(frames_[0]));
-  cpu.push(view_of(frames_[1]));
+  cpu.push(view_of(f0));
+  cpu.push(view_of(f1));
   EXPECT_TRUE(cpu.device_stage_times().empty());
 }
 

@@ -38,6 +38,9 @@ constexpr std::uint32_t kRefineUpdate[] =
 constexpr std::uint32_t kConvexUpsample[] =
 #include "convex_upsample.spv.inc"
     ;
+constexpr std::uint32_t kFrameU8[] =
+#include "frame_u8.spv.inc"
+    ;
 constexpr std::uint32_t kConv2dFp16[] =
 #include "conv2d_fp16.spv.inc"
     ;
@@ -71,6 +74,9 @@ constexpr std::uint32_t kRefineUpdateFp16[] =
 constexpr std::uint32_t kConvexUpsampleFp16[] =
 #include "convex_upsample_fp16.spv.inc"
     ;
+constexpr std::uint32_t kFrameU8Fp16[] =
+#include "frame_u8_fp16.spv.inc"
+    ;
 }  // namespace
 
 std::span<const std::uint32_t> spirv(Shader shader, bool fp16) {
@@ -86,6 +92,7 @@ std::span<const std::uint32_t> spirv(Shader shader, bool fp16) {
     case Shader::local_correlation: return fp16 ? std::span<const std::uint32_t>(kLocalCorrelationFp16) : std::span<const std::uint32_t>(kLocalCorrelation);
     case Shader::refine_update: return fp16 ? std::span<const std::uint32_t>(kRefineUpdateFp16) : std::span<const std::uint32_t>(kRefineUpdate);
     case Shader::convex_upsample: return fp16 ? std::span<const std::uint32_t>(kConvexUpsampleFp16) : std::span<const std::uint32_t>(kConvexUpsample);
+    case Shader::frame_u8: return fp16 ? std::span<const std::uint32_t>(kFrameU8Fp16) : std::span<const std::uint32_t>(kFrameU8);
   }
   return {};
 }
@@ -103,6 +110,7 @@ const char* shader_name(Shader shader) {
     case Shader::local_correlation: return "local_correlation";
     case Shader::refine_update: return "refine_update";
     case Shader::convex_upsample: return "convex_upsample";
+    case Shader::frame_u8: return "frame_u8";
   }
   return "?";
 }

@@ -18,8 +18,9 @@ enum class Shader {
   local_correlation,
   refine_update,
   convex_upsample,
+  frame_u8,        // a frame's 8-bit pixels as the network's input
 };
-inline constexpr std::size_t kShaderCount = 11;
+inline constexpr std::size_t kShaderCount = 12;
 
 // fp16: the variant that stores tensors as float16_t (precision.glsl).
 std::span<const std::uint32_t> spirv(Shader shader, bool fp16);

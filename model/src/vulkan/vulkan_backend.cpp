@@ -19,6 +19,14 @@ class VulkanBackend final : public InferenceBackend {
   int width() const override { return network_.width(); }
   int height() const override { return network_.height(); }
   void encode(const Tensor& image, int slot) override { network_.encode(image, slot); }
+  // Padding mode on the device; a resize (OpenCV's fixed-point bilinear) stays on the CPU.
+  bool encode_frame(const ImageView& image, const FrameGeometry& g, ChannelOrder network_order, int slot) override {
+    if (g.resize) return false;
+    network_.encode(vulkan::VulkanNetwork::Frame{image.data, image.stride, image.width, image.height, g.pad_left,
+                                                 g.pad_top, image.order != network_order},
+                    slot);
+    return true;
+  }
   void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer) override {
     network_.flow(slot0, slot1, iterations, out, observer);
   }

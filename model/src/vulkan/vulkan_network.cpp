@@ -440,17 +440,12 @@ VkCommandBuffer allocate_commands(VulkanDevice& device, VkCommandPool pool) {
 }
 }  // namespace
 
-const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, int slot0, int slot1,
-                                                 const Iterations* iterations) {
+const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, const std::function<void(Recorder&)>& record) {
   if (auto it = command_buffers_.find(key); it != command_buffers_.end()) return it->second;
   Pass pass{allocate_commands(device_, pool_), {}};
   try {
     Recorder r(*this, pass.commands, nullptr, &pass.marks);
-    if (iterations) {
-      record_flow(r, slot0, slot1, *iterations);
-    } else {
-      record_encode(r, slot0);
-    }
+    record(r);
     r.end();
   } catch (...) {
     vkFreeCommandBuffers(device_.handle(), pool_, 1, &pass.commands);
@@ -489,7 +484,19 @@ void VulkanNetwork::encode(const Tensor& image, int slot) {
     dst[2 * hw + p] = image.data[3 * p + 2];
   }
   store(staging_.data(), staging_.size(), upload_.mapped());
-  run(cached("encode" + std::to_string(slot), slot, 0, nullptr));
+  run(cached("encode" + std::to_string(slot), [&](Recorder& r) { record_encode(r, slot, nullptr); }));
+}
+
+void VulkanNetwork::encode(const Frame& frame, int slot) {
+  auto* dst = reinterpret_cast<std::uint8_t*>(upload_.mapped());
+  const std::size_t row = static_cast<std::size_t>(frame.width) * 3;
+  for (int y = 0; y < frame.height; ++y) std::memcpy(dst + y * row, frame.data + y * frame.stride, row);
+  const FrameLayout layout{frame.width, frame.height, frame.pad_left, frame.pad_top, frame.swap};
+  // One recording per slot and layout: a session's frames keep one size and channel order.
+  const std::string key = "encode_u8:" + std::to_string(slot) + ":" + std::to_string(frame.width) + "x" +
+                          std::to_string(frame.height) + "+" + std::to_string(frame.pad_left) + "+" +
+                          std::to_string(frame.pad_top) + (frame.swap ? ":swap" : "");
+  run(cached(key, [&](Recorder& r) { record_encode(r, slot, &layout); }));
 }
 
 void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,
@@ -502,7 +509,7 @@ void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Ten
   } else {
     const std::string key = "flow" + std::to_string(slot0) + std::to_string(slot1) + ":" +
                             std::to_string(iterations.s16) + ":" + std::to_string(iterations.s8);
-    run(cached(key, slot0, slot1, &iterations));
+    run(cached(key, [&](Recorder& r) { record_flow(r, slot0, slot1, iterations); }));
   }
   out.resize(height_, width_, 2);
   const std::size_t hw = static_cast<std::size_t>(height_) * width_;
@@ -516,11 +523,19 @@ void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Ten
   if (observer && *observer) (*observer)(StageTensor{"flow", 0, height_, width_, 2, out.data.data()});
 }
 
-void VulkanNetwork::record_encode(Recorder& r, int slot) {
+void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* frame) {
   const int h = height_, w = width_;
   const View input{&input_, 0, 3, h, w}, half{&half_, 0, 3, h / 2, w / 2}, quarter{&quarter_, 0, 3, h / 4, w / 4},
       eighth{&eighth_, 0, 3, h / 8, w / 8};
-  r.copy_raw(upload_, input_, static_cast<std::size_t>(3) * h * w);
+  if (frame) {
+    struct {
+      int in_w, in_h, out_w, out_h, pad_left, pad_top, swap;
+    } p{frame->width, frame->height, w, h, frame->pad_left, frame->pad_top, frame->swap ? 1 : 0};
+    r.dispatch(Shader::frame_u8, {&upload_, nullptr, &input_, nullptr}, &p, sizeof p,
+               groups(static_cast<long>(h) * w, kLocal));
+  } else {
+    r.copy_raw(upload_, input_, static_cast<std::size_t>(3) * h * w);
+  }
   r.avgpool(input, half);
   r.avgpool(half, quarter);
   r.avgpool(quarter, eighth);

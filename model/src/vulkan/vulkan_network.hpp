@@ -6,7 +6,9 @@
 // read it back. Without one, a recorded pass writes a GPU timestamp after each named stage
 // (where the queue has timestamps), so every pass also measures where its time went.
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -45,6 +47,16 @@ class VulkanNetwork {
 
   // image: [height, width, 3] NHWC in 0..1, as the CPU backend takes it.
   void encode(const Tensor& image, int slot);
+  // An 8-bit interleaved frame no larger than the model size, converted on the device: centred
+  // at (pad_left, pad_top) in edge-replicated padding, its first and third channels exchanged
+  // when `swap`; what prepare_input() does in padding mode.
+  struct Frame {
+    const std::uint8_t* data;
+    std::ptrdiff_t stride;
+    int width, height, pad_left, pad_top;
+    bool swap;
+  };
+  void encode(const Frame& frame, int slot);
   // out: [height, width, 2] NHWC.
   void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer);
   // The device time of each named stage of the passes run since the last call (none for a
@@ -66,13 +78,18 @@ class VulkanNetwork {
     std::vector<std::string> marks;
   };
   static constexpr uint32_t kTimestamps = 1024;  // per pass; stages past it are not timed
-  void record_encode(Recorder& r, int slot);
+  struct FrameLayout {  // where an 8-bit frame lies in the upload buffer
+    int width, height, pad_left, pad_top;
+    bool swap;
+  };
+  // frame: the upload holds an 8-bit frame; nullptr: the upload holds the input as floats.
+  void record_encode(Recorder& r, int slot, const FrameLayout* frame);
   void record_flow(Recorder& r, int slot0, int slot1, const Iterations& iterations);
   void record_attention_layer(Recorder& r, const DeviceAttentionLayer& w, const Buffer& src, const Buffer& tgt,
                               const Buffer& out);
   void record_refinement(Recorder& r, const DeviceRefine& w, Refine& buffers, const View& f0, const View& f1,
                          const View& flow, int iterations, const std::string& scale);
-  const Pass& cached(const std::string& key, int slot0, int slot1, const Iterations* iterations);
+  const Pass& cached(const std::string& key, const std::function<void(Recorder&)>& record);
   void run(const Pass& pass);
   VkDescriptorSet descriptor_set(const std::array<VkBuffer, 4>& buffers);
   void initialise_constants();
