@@ -22,8 +22,9 @@ class VulkanBackend final : public InferenceBackend {
   // Padding mode on the device; a resize (OpenCV's fixed-point bilinear) stays on the CPU.
   bool encode_frame(const ImageView& image, const FrameGeometry& g, ChannelOrder network_order, int slot) override {
     if (g.resize) return false;
-    network_.encode(vulkan::VulkanNetwork::Frame{image.data, image.stride, image.width, image.height, g.pad_left,
-                                                 g.pad_top, image.order != network_order},
+    network_.encode(vulkan::VulkanNetwork::Frame{image.data, image.stride,
+                                                 {image.width, image.height, g.pad_left, g.pad_top,
+                                                  image.order != network_order}},
                     slot);
     return true;
   }

@@ -489,13 +489,13 @@ void VulkanNetwork::encode(const Tensor& image, int slot) {
 
 void VulkanNetwork::encode(const Frame& frame, int slot) {
   auto* dst = reinterpret_cast<std::uint8_t*>(upload_.mapped());
-  const std::size_t row = static_cast<std::size_t>(frame.width) * 3;
-  for (int y = 0; y < frame.height; ++y) std::memcpy(dst + y * row, frame.data + y * frame.stride, row);
-  const FrameLayout layout{frame.width, frame.height, frame.pad_left, frame.pad_top, frame.swap};
+  const FrameLayout& layout = frame.layout;
+  const std::size_t row = static_cast<std::size_t>(layout.width) * 3;
+  for (int y = 0; y < layout.height; ++y) std::memcpy(dst + y * row, frame.data + y * frame.stride, row);
   // One recording per slot and layout: a session's frames keep one size and channel order.
-  const std::string key = "encode_u8:" + std::to_string(slot) + ":" + std::to_string(frame.width) + "x" +
-                          std::to_string(frame.height) + "+" + std::to_string(frame.pad_left) + "+" +
-                          std::to_string(frame.pad_top) + (frame.swap ? ":swap" : "");
+  const std::string key = "encode_u8:" + std::to_string(slot) + ":" + std::to_string(layout.width) + "x" +
+                          std::to_string(layout.height) + "+" + std::to_string(layout.pad_left) + "+" +
+                          std::to_string(layout.pad_top) + (layout.swap ? ":swap" : "");
   run(cached(key, [&](Recorder& r) { record_encode(r, slot, &layout); }));
 }
 

@@ -50,11 +50,14 @@ class VulkanNetwork {
   // An 8-bit interleaved frame no larger than the model size, converted on the device: centred
   // at (pad_left, pad_top) in edge-replicated padding, its first and third channels exchanged
   // when `swap`; what prepare_input() does in padding mode.
+  struct FrameLayout {  // an 8-bit frame's size, where it sits in the input, its channel order
+    int width, height, pad_left, pad_top;
+    bool swap;
+  };
   struct Frame {
     const std::uint8_t* data;
     std::ptrdiff_t stride;
-    int width, height, pad_left, pad_top;
-    bool swap;
+    FrameLayout layout;
   };
   void encode(const Frame& frame, int slot);
   // out: [height, width, 2] NHWC.
@@ -78,10 +81,6 @@ class VulkanNetwork {
     std::vector<std::string> marks;
   };
   static constexpr uint32_t kTimestamps = 1024;  // per pass; stages past it are not timed
-  struct FrameLayout {  // where an 8-bit frame lies in the upload buffer
-    int width, height, pad_left, pad_top;
-    bool swap;
-  };
   // frame: the upload holds an 8-bit frame; nullptr: the upload holds the input as floats.
   void record_encode(Recorder& r, int slot, const FrameLayout* frame);
   void record_flow(Recorder& r, int slot0, int slot1, const Iterations& iterations);
