@@ -45,6 +45,10 @@ fi
 
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+# CI starts two of these at once (the arm64 and Ubuntu roots' host tools): the second waits for
+# the first rather than failing on apt's lock.
+exec 9>"${TMPDIR:-/tmp}/neuflow-install-deps.lock"
+flock 9
 echo "install-deps: installing ${missing[*]}"
 $sudo apt-get update -q
 DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"

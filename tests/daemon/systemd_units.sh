@@ -115,12 +115,22 @@ case $mode in
     sysusers="$prefix/lib/sysusers.d/neuflow.conf"
     [ -f "$sysusers" ] || fail "the sysusers.d file that creates the group neuflow is not installed ($sysusers)"
     if command -v systemd-sysusers > /dev/null; then
-      # --dry-run with --root: parsed and planned against an empty tree, nothing created here.
+      # Against an empty tree (--root), so nothing is created on this machine: --dry-run where
+      # systemd has it (250 and later); on 249 (Ubuntu 22.04, JetPack 6) the group is really
+      # created in that tree and read back from its /etc/group.
       mkdir -p "$work/root/etc"
-      out=$(systemd-sysusers --root="$work/root" --dry-run "$sysusers" 2>&1) ||
-        { echo "$out"; fail "systemd-sysusers rejects $sysusers"; }
-      grep -q "neuflow" <<<"$out" || { echo "$out"; fail "systemd-sysusers would not create the group neuflow"; }
-      echo "ok: systemd-sysusers would create: $out"
+      if systemd-sysusers --help 2>&1 | grep -q -- '--dry-run'; then
+        out=$(systemd-sysusers --root="$work/root" --dry-run "$sysusers" 2>&1) ||
+          { echo "$out"; fail "systemd-sysusers rejects $sysusers"; }
+        grep -q "neuflow" <<<"$out" || { echo "$out"; fail "systemd-sysusers would not create the group neuflow"; }
+        echo "ok: systemd-sysusers would create: $out"
+      else
+        out=$(systemd-sysusers --root="$work/root" "$sysusers" 2>&1) ||
+          { echo "$out"; fail "systemd-sysusers rejects $sysusers"; }
+        grep -q '^neuflow:' "$work/root/etc/group" 2>/dev/null ||
+          { echo "$out"; fail "systemd-sysusers did not create the group neuflow"; }
+        echo "ok: systemd-sysusers created: $(grep '^neuflow:' "$work/root/etc/group")"
+      fi
     fi
     ;;
 

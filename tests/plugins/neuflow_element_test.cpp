@@ -317,7 +317,9 @@ TEST_F(NeuflowElement, LiveRunStaysBoundedInLatencyAndMemory) {
 // sync, so a live pipeline without a queue after the element runs as fast as one with it.
 // Measured before: 2.85 flows/s without the queue against 6.4 with it (320x256 at 30 fps,
 // threads=2). Both are measured here, alternately, and compared (no absolute timing); ctest
-// runs this test alone (RUN_SERIAL, tests/plugins/CMakeLists.txt).
+// runs this test alone (RUN_SERIAL, tests/plugins/CMakeLists.txt). The bound sits between that
+// regression's ratio (0.45) and the spread of repeated measurements on a shared 2-core host
+// (one run there: 6.39 and 5.19 flows/s without the queue, 6.59 and 7.39 with it: ratio 0.83).
 TEST_F(NeuflowElement, WithoutAQueueALivePipelineKeepsTheRateOfOneWithAQueue) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "rates under the sanitizers say nothing; the release build runs this comparison";
@@ -356,7 +358,7 @@ TEST_F(NeuflowElement, WithoutAQueueALivePipelineKeepsTheRateOfOneWithAQueue) {
   std::printf("flows/s without a queue %.2f (%.2f, %.2f), with a queue %.2f (%.2f, %.2f): ratio %.2f\n", without,
               without_a, without_b, with_queue, with_a, with_b, without / with_queue);
   ASSERT_GT(with_queue, 0.0);
-  EXPECT_GE(without, 0.85 * with_queue) << "inference waits for the sink's clock sync again";
+  EXPECT_GE(without, 0.7 * with_queue) << "inference waits for the sink's clock sync again";
 }
 
 TEST_F(NeuflowElement, SurvivesManyStateCycles) {

@@ -3,80 +3,80 @@
 namespace neuflow::model::vulkan {
 
 namespace {
-// Each .spv.inc is glslc's C output (-mfmt=c): a braced list of SPIR-V words, generated from
-// shaders/ by the build (model/CMakeLists.txt).
-constexpr std::uint32_t kConv2d[] =
+// Each .spv.inc is the shader compiler's list of SPIR-V words, comma-separated without braces
+// (glslc -mfmt=num, glslangValidator -x), generated from shaders/ by the build (model/CMakeLists.txt).
+constexpr std::uint32_t kConv2d[] = {
 #include "conv2d.spv.inc"
-    ;
-constexpr std::uint32_t kMatmul[] =
+};
+constexpr std::uint32_t kMatmul[] = {
 #include "matmul.spv.inc"
-    ;
-constexpr std::uint32_t kAvgpool2x[] =
+};
+constexpr std::uint32_t kAvgpool2x[] = {
 #include "avgpool2x.spv.inc"
-    ;
-constexpr std::uint32_t kResample[] =
+};
+constexpr std::uint32_t kResample[] = {
 #include "resample.spv.inc"
-    ;
-constexpr std::uint32_t kAxpby[] =
+};
+constexpr std::uint32_t kAxpby[] = {
 #include "axpby.spv.inc"
-    ;
-constexpr std::uint32_t kChannelAffine[] =
+};
+constexpr std::uint32_t kChannelAffine[] = {
 #include "channel_affine.spv.inc"
-    ;
-constexpr std::uint32_t kSoftmaxRows[] =
+};
+constexpr std::uint32_t kSoftmaxRows[] = {
 #include "softmax_rows.spv.inc"
-    ;
-constexpr std::uint32_t kLayerNorm[] =
+};
+constexpr std::uint32_t kLayerNorm[] = {
 #include "layer_norm.spv.inc"
-    ;
-constexpr std::uint32_t kLocalCorrelation[] =
+};
+constexpr std::uint32_t kLocalCorrelation[] = {
 #include "local_correlation.spv.inc"
-    ;
-constexpr std::uint32_t kRefineUpdate[] =
+};
+constexpr std::uint32_t kRefineUpdate[] = {
 #include "refine_update.spv.inc"
-    ;
-constexpr std::uint32_t kConvexUpsample[] =
+};
+constexpr std::uint32_t kConvexUpsample[] = {
 #include "convex_upsample.spv.inc"
-    ;
-constexpr std::uint32_t kFrameU8[] =
+};
+constexpr std::uint32_t kFrameU8[] = {
 #include "frame_u8.spv.inc"
-    ;
-constexpr std::uint32_t kConv2dFp16[] =
+};
+constexpr std::uint32_t kConv2dFp16[] = {
 #include "conv2d_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kMatmulFp16[] =
+};
+constexpr std::uint32_t kMatmulFp16[] = {
 #include "matmul_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kAvgpool2xFp16[] =
+};
+constexpr std::uint32_t kAvgpool2xFp16[] = {
 #include "avgpool2x_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kResampleFp16[] =
+};
+constexpr std::uint32_t kResampleFp16[] = {
 #include "resample_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kAxpbyFp16[] =
+};
+constexpr std::uint32_t kAxpbyFp16[] = {
 #include "axpby_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kChannelAffineFp16[] =
+};
+constexpr std::uint32_t kChannelAffineFp16[] = {
 #include "channel_affine_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kSoftmaxRowsFp16[] =
+};
+constexpr std::uint32_t kSoftmaxRowsFp16[] = {
 #include "softmax_rows_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kLayerNormFp16[] =
+};
+constexpr std::uint32_t kLayerNormFp16[] = {
 #include "layer_norm_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kLocalCorrelationFp16[] =
+};
+constexpr std::uint32_t kLocalCorrelationFp16[] = {
 #include "local_correlation_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kRefineUpdateFp16[] =
+};
+constexpr std::uint32_t kRefineUpdateFp16[] = {
 #include "refine_update_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kConvexUpsampleFp16[] =
+};
+constexpr std::uint32_t kConvexUpsampleFp16[] = {
 #include "convex_upsample_fp16.spv.inc"
-    ;
-constexpr std::uint32_t kFrameU8Fp16[] =
+};
+constexpr std::uint32_t kFrameU8Fp16[] = {
 #include "frame_u8_fp16.spv.inc"
-    ;
+};
 }  // namespace
 
 std::span<const std::uint32_t> spirv(Shader shader, bool fp16) {

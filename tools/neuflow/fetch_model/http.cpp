@@ -217,8 +217,15 @@ void http_get(const std::string& url, HttpBodySink& sink, const HttpOptions& opt
   curl_easy_setopt(h, CURLOPT_ERRORBUFFER, detail);
   // The hash is what makes the file trustworthy, but there is no reason to speak anything
   // but HTTP(S), on the first request or after a redirect.
+  // The _STR options came with libcurl 7.85, which deprecated the bitmask ones; Ubuntu 22.04
+  // (JetPack 6) has 7.81.
+#if LIBCURL_VERSION_NUM >= 0x075500
   curl_easy_setopt(h, CURLOPT_PROTOCOLS_STR, "http,https");
   curl_easy_setopt(h, CURLOPT_REDIR_PROTOCOLS_STR, "http,https");
+#else
+  curl_easy_setopt(h, CURLOPT_PROTOCOLS, static_cast<long>(CURLPROTO_HTTP | CURLPROTO_HTTPS));
+  curl_easy_setopt(h, CURLOPT_REDIR_PROTOCOLS, static_cast<long>(CURLPROTO_HTTP | CURLPROTO_HTTPS));
+#endif
   curl_easy_setopt(h, CURLOPT_FOLLOWLOCATION, 1L);
   curl_easy_setopt(h, CURLOPT_MAXREDIRS, kMaxRedirects);
   curl_easy_setopt(h, CURLOPT_FAILONERROR, 1L);

@@ -17,12 +17,16 @@ const int R = 4, WIN = 9, N = 10;
 void main() {
   const int plane = p.h * p.w;
   const float norm = inversesqrt(float(p.channels));
+  // Zero as a run-time value, not a literal: VALUE(0.0) is a 16-bit constant in the fp16
+  // variant, and glslang 11 (Ubuntu 22.04's glslangValidator) emits it without declaring the
+  // Float16 capability, an invalid module the validation layer rejects.
+  const float zero = 0.0 * norm;
   FOR_EACH(pix, plane) {
     const int y = pix / p.w, x = pix - y * p.w;
     const float px = float(x) + float(flow[p.flow_off + pix]);
     const float py = float(y) + float(flow[p.flow_off + plane + pix]);
     if (!(abs(px) < 1e6 && abs(py) < 1e6)) {  // far outside (or not a number): all zero
-      for (int k = 0; k < WIN * WIN; ++k) dst[p.out_off + k * plane + pix] = VALUE(0.0);
+      for (int k = 0; k < WIN * WIN; ++k) dst[p.out_off + k * plane + pix] = VALUE(zero);
       continue;
     }
     const float fx0 = floor(px), fy0 = floor(py);
