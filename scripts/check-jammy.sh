@@ -6,18 +6,22 @@
 # minimum versions on real packages. It runs on x86-64 (Ubuntu's arm64 archive, ports.ubuntu.com,
 # is not reachable here); scripts/check-arm64.sh covers the arm64 code on Debian 12.
 #
-# Usage: bash scripts/check-jammy.sh [--root-only] [WORK_DIR]   (WORK_DIR: build/jammy)
+# Usage: bash scripts/check-jammy.sh [--root-only | --sanitize] [WORK_DIR]   (WORK_DIR: build/jammy)
 #   --root-only  only make the Ubuntu root (CI does this while the native build compiles)
+#   --sanitize   build and test with the asan preset (ASan + UBSan, GCC 11's), benchmarks
+#                included, instead of release: CI's sanitizer run and its Ubuntu 22.04 run in
+#                one build and one pass of the suite
 # Needs root (or sudo): the packages are installed into the root by dpkg, and the build runs in
 # it through chroot with /proc, /dev and the fixtures (NEUFLOW_SHARED_DIR) mounted.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-root_only=0
+root_only=0 preset=release
 while [ $# -gt 0 ]; do
   case "$1" in
     --root-only) root_only=1; shift ;;
-    -*) echo "usage: $0 [--root-only] [WORK_DIR]" >&2; exit 64 ;;
+    --sanitize) preset=asan; shift ;;
+    -*) echo "usage: $0 [--root-only | --sanitize] [WORK_DIR]" >&2; exit 64 ;;
     *) break ;;
   esac
 done
@@ -121,9 +125,12 @@ in_root 'echo "check-jammy: $(cmake --version | head -1), $(g++ --version | head
 ' oneDNN $(dpkg-query -W -f="\${Version}" libdnnl-dev)"'
 
 # --- build and test, with the presets as CMake 3.22 reads them ------------------------------
+# The asan preset leaves the benchmarks out; a Jetson build has them (NEUFLOW_BUILD_BENCHMARKS
+# is on by default), so they are built here whatever the preset.
 start=$(date +%s)
-in_root 'cmake --preset release -DTOMLPP_INCLUDE_DIR=/opt/tomlplusplus/include >/dev/null && cmake --build --preset release -- -k 0'
-say "every target built in Ubuntu 22.04 ($(( $(date +%s) - start )) s)"
+in_root "cmake --preset $preset -DTOMLPP_INCLUDE_DIR=/opt/tomlplusplus/include -DNEUFLOW_BUILD_BENCHMARKS=ON >/dev/null \
+  && cmake --build --preset $preset -- -k 0"
+say "every target built in Ubuntu 22.04 with the $preset preset ($(( $(date +%s) - start )) s)"
 # Left out: the Vulkan tests that run the network on lavapipe again (1-2 min each there, the
 # same host code as the Debian build's); kept, every shader through the validation layer as
 # this build's glslangValidator compiled it, in both precisions, and every fp32 stage against
@@ -131,5 +138,5 @@ say "every target built in Ubuntu 22.04 ($(( $(date +%s) - start )) s)"
 lavapipe_repeats='NetworkReference\.EveryStageMatchesTheReference/vulkan|VulkanSession\.(StreamingGivesTheSameFlowAsPairs'
 lavapipe_repeats+='|Fp16StaysWithinItsBoundOfFp32|FramesConvertedOnTheDeviceGiveTheCpusFlow|DeviceTimestampsTimeEveryStageOfAFrame)'
 start=$(date +%s)
-in_root "ctest --preset release -E '$lavapipe_repeats'"
-say "the test suite passes in Ubuntu 22.04 ($(( $(date +%s) - start )) s; the lavapipe repeats left out)"
+in_root "ctest --preset $preset -E '$lavapipe_repeats'"
+say "the test suite passes in Ubuntu 22.04 with the $preset preset ($(( $(date +%s) - start )) s; the lavapipe repeats left out)"

@@ -49,4 +49,20 @@ foreach(test_case
            COMMAND ${NEUFLOW_E2E_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/e2e_test.py -v ${test_case})
   set_tests_properties(daemon.e2e.${test_case} PROPERTIES LABELS "daemon;e2e" ENVIRONMENT "${e2e_env}"
                        TIMEOUT 300 RESOURCE_LOCK neuflowd_e2e)
+  if(NEUFLOW_SANITIZE)
+    set_tests_properties(daemon.e2e.${test_case} PROPERTIES FIXTURES_REQUIRED neuflowd_e2e_registry)
+  endif()
 endforeach()
+
+if(NEUFLOW_SANITIZE)
+  # A registry scan in neuflowd's own process loads every installed plugin into it. On Ubuntu
+  # 22.04 one of them (webrtc, through libnice and GUPnP) links libsoup 2, and libsoup aborts a
+  # process that has both (neuflowd's metrics server links libsoup 3). So GStreamer's
+  # gst-inspect-1.0, with the sanitizer runtimes preloaded, makes the registry first; neuflowd
+  # then finds it up to date and loads only the plugins its streams use, as in a release build.
+  find_program(GST_INSPECT gst-inspect-1.0 REQUIRED ONLY_CMAKE_FIND_ROOT_PATH)
+  neuflow_gst_tool_env(e2e_scan_env "${CMAKE_CURRENT_BINARY_DIR}/e2e-registry.bin")
+  add_test(NAME daemon.e2e.registry COMMAND ${GST_INSPECT} neuflow)
+  set_tests_properties(daemon.e2e.registry PROPERTIES LABELS "daemon;e2e" ENVIRONMENT "${e2e_scan_env}"
+                       FIXTURES_SETUP neuflowd_e2e_registry RESOURCE_LOCK neuflowd_e2e TIMEOUT 300)
+endif()
