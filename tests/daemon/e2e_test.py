@@ -439,6 +439,38 @@ class DaemonFailures(DaemonTestCase):
         self.assertTrue(flow_files(good), "the CPU stream stopped producing")
         self.assertTrue(flow_files(lava), "the stream on Vulkan device 0 produced nothing")
 
+    def test_a_lost_gpu_restarts_its_stream_on_a_new_device_while_the_others_run(self):
+        # NEUFLOW_VULKAN_LOSE_DEVICE_AFTER stands in for a GPU hang or reset: every device
+        # neuflowd opens reports itself lost at its sixth submission. The stream on it fails
+        # naming the device, backs off and plays again on a newly opened device, more than once;
+        # the CPU stream goes on producing.
+        if os.environ.get("NEUFLOW_REQUIRE_VULKAN", "0") in ("", "0") and shutil.which("vulkaninfo") is None:
+            self.skipTest("no Vulkan here (NEUFLOW_REQUIRE_VULKAN=1 makes this a failure)")
+        good = os.path.join(self.dir, "good")
+        lava = os.path.join(self.dir, "lava")
+        text = ('[daemon]\nrestart-delay-min = 0.5\nrestart-delay-max = 1.0\n' +
+                stream_block("lava", test_source(fps=5, width=32, height=32), [f'  type = "files"\n  directory = "{lava}"'],
+                             flow='  backend = "vulkan"\n  device = 0\n') +
+                stream_block("good", test_source(), [f'  type = "files"\n  directory = "{good}"'],
+                             flow='  backend = "cpu"\n'))
+        extra = {"NEUFLOW_VULKAN_LOSE_DEVICE_AFTER": "5"}
+        if os.environ.get("NEUFLOW_E2E_SANITIZED") == "1":  # see the test above
+            extra.update({"LSAN_OPTIONS": "", "ASAN_OPTIONS": "detect_leaks=0:abort_on_error=1"})
+        d = self.start(text, extra_env=extra)
+        d.wait_ready(60)
+        playing = r"stream lava: playing on vulkan device 0"
+        d.wait_log(playing, timeout=120)
+        d.wait_log(r"stream lava: .*vulkan device 0.*lost", timeout=120)
+        d.wait_log(r"stream lava: .*restarting in", timeout=60)
+        d.wait_log(playing + r"(.*\n)+.*" + playing + r"(.*\n)+.*" + playing, timeout=180)
+        files_before = len(flow_files(good))
+        deadline = time.monotonic() + 60
+        while len(flow_files(good)) <= files_before and time.monotonic() < deadline:
+            time.sleep(0.2)
+        self.assertGreater(len(flow_files(good)), files_before, "the CPU stream stopped producing")
+        self.assertTrue(flow_files(lava), "the stream on the GPU produced nothing before it was lost")
+        self.assertEqual(d.stop(), 0)
+
     def test_failing_source_restarts_while_other_stream_runs(self):
         # Nothing listens on this port: the RTSP source fails at once, every time.
         probe = socket.socket()

@@ -35,6 +35,7 @@ foreach(test_case
     DaemonFailures.test_failing_source_restarts_while_other_stream_runs
     DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
     DaemonFailures.test_a_missing_gpu_restarts_its_stream_while_the_others_run
+    DaemonFailures.test_a_lost_gpu_restarts_its_stream_on_a_new_device_while_the_others_run
     CheckConfig.test_valid_config_passes
     CheckConfig.test_errors_name_line_and_exit_78
     CheckConfig.test_unknown_choice_offers_the_closest_value

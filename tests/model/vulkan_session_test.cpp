@@ -1,8 +1,8 @@
 // The Vulkan backend as a user relies on it: the same flow and stages as the CPU at a size
 // that is not a multiple of 16 with other iteration counts, streaming equal to pairs, and
-// failures (a device that does not exist, device memory running out) that are errors naming
-// the device, after which a new session works; backend=auto falls back to the CPU with one
-// warning. Runs on lavapipe in CI, under the validation layer.
+// failures (a device that does not exist, device memory running out, a lost device) that are
+// errors naming the device, after which a new session works; backend=auto falls back to the
+// CPU with one warning. Runs on lavapipe in CI, under the validation layer.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <map>
+#include <optional>
 
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -213,6 +214,49 @@ TEST_F(VulkanSession, RunningOutOfDeviceMemoryIsAnErrorAndAutoFallsBackToTheCpu)
   EXPECT_EQ(fallback.backend_description(), "cpu");
   EXPECT_NE(fallback.fallback_warning().find("out of device memory"), std::string::npos) << fallback.fallback_warning();
   unsetenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB");
+}
+
+// A lost device (NEUFLOW_VULKAN_LOSE_DEVICE_AFTER stands in for a GPU hang or reset) is an error
+// naming the device; that session stays failed and says to start a new one; a new session opens
+// the device again and gives the same flow as before the loss.
+TEST_F(VulkanSession, ALostDeviceIsAnErrorNamingItAndANewSessionRunsAgain) {
+  cv::Mat a, b;
+  cv::resize(frames_[0], a, cv::Size(64, 48));
+  cv::resize(frames_[1], b, cv::Size(64, 48));
+  const SessionOptions options{.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0};
+  flow::FlowField before;
+  {
+    FlowSession session(model_, options);
+    before = session.compute(view_of(a), view_of(b));
+  }
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER", "3", 1), 0);
+  {
+    std::optional<FlowSession> session;
+    try {
+      session.emplace(model_, options);  // the device is opened again, with the variable set
+      for (int i = 0; i < 8; ++i) session->compute(view_of(a), view_of(b));
+      ADD_FAILURE() << "the device was not lost in 8 pairs";
+    } catch (const BackendError& e) {
+      EXPECT_EQ(e.kind(), BackendError::Kind::device_lost) << e.what();
+      EXPECT_NE(std::string(e.what()).find("vulkan device 0"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("lost"), std::string::npos) << e.what();
+    }
+    unsetenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER");
+    if (session) {
+      try {
+        session->compute(view_of(a), view_of(b));
+        ADD_FAILURE() << "a session on a lost device computed again";
+      } catch (const BackendError& e) {
+        EXPECT_EQ(e.kind(), BackendError::Kind::device_lost) << e.what();
+        EXPECT_NE(std::string(e.what()).find("start a new session"), std::string::npos) << e.what();
+      }
+    }
+  }
+  unsetenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER");
+  FlowSession again(model_, options);
+  const auto after = again.compute(view_of(a), view_of(b));
+  const auto e = compare(before, after);
+  EXPECT_EQ(e.max, 0.0) << "the same pair on a newly opened device";
 }
 
 // fp16 storage against fp32 on the same device, at two sizes. The bound (documented in

@@ -36,6 +36,18 @@ std::size_t budget_from_environment() {
   return (end && *end == '\0') ? static_cast<std::size_t>(mb) << 20 : 0;
 }
 
+// NEUFLOW_VULKAN_LOSE_DEVICE_AFTER=N: each device opened while it is set reports itself lost at
+// its (N+1)th submission, as a driver does after a GPU hang or reset; nothing else can lose a
+// device on purpose, and the recovery (the error, a new session on a new device, neuflowd's
+// restart of that stream) needs testing. -1 when unset.
+long long lose_after_from_environment() {
+  const char* v = std::getenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER");
+  if (v == nullptr || *v == '\0') return -1;
+  char* end = nullptr;
+  const long long n = std::strtoll(v, &end, 10);
+  return (end && *end == '\0' && n >= 0) ? n : -1;
+}
+
 int pick_default(const std::vector<VkPhysicalDevice>& devices) {
   for (std::size_t i = 0; i < devices.size(); ++i) {
     if (describe(devices[i], static_cast<int>(i)).is_gpu()) return static_cast<int>(i);
@@ -82,7 +94,8 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
 }
 
 VulkanDevice::VulkanDevice(VkPhysicalDevice physical, int index)
-    : physical_(physical), info_(describe(physical, index)), budget_(budget_from_environment()) {
+    : physical_(physical), info_(describe(physical, index)), budget_(budget_from_environment()),
+      lose_after_(lose_after_from_environment()) {
   label_ = "vulkan device " + std::to_string(index) + " (" + info_.name + ")";
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
 
@@ -303,7 +316,8 @@ void VulkanDevice::submit_and_wait(VkCommandBuffer commands, VkFence fence) {
     // Sessions on one device share its queue, which Vulkan requires to be used by one thread
     // at a time; the wait happens outside the lock so their work overlaps on the device.
     const std::lock_guard lock(queue_mutex_);
-    r = vkQueueSubmit(queue_, 1, &submit, fence);
+    const bool lose_now = lose_after_ >= 0 && submissions_++ >= lose_after_;
+    r = lose_now ? VK_ERROR_DEVICE_LOST : vkQueueSubmit(queue_, 1, &submit, fence);
   }
   if (r == VK_SUCCESS) r = vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX);
   if (r == VK_SUCCESS) r = vkResetFences(device_, 1, &fence);

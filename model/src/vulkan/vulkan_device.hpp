@@ -72,7 +72,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
 
   // Submits and waits on `fence` (the caller's, unsignalled; left unsignalled). Throws
   // BackendError (device lost, ...) naming the device. After a lost device every later call
-  // fails and open() creates a new device.
+  // fails and open() creates a new device. NEUFLOW_VULKAN_LOSE_DEVICE_AFTER=N, when a device is
+  // opened, makes it report itself lost at its (N+1)th submission (to test that path).
   void submit_and_wait(VkCommandBuffer commands, VkFence fence);
 
   // Throws if `where` failed, naming this device.
@@ -109,6 +110,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   std::mutex memory_mutex_;
   std::size_t allocated_ = 0;
   std::size_t budget_ = 0;  // 0: no budget
+  long long lose_after_ = -1;  // NEUFLOW_VULKAN_LOSE_DEVICE_AFTER; -1: never
+  long long submissions_ = 0;  // guarded by queue_mutex_
   std::atomic<bool> lost_{false};
 };
 
