@@ -14,7 +14,8 @@
 namespace neuflow::model {
 namespace {
 
-void fill_random(std::vector<float>& v, std::mt19937& rng, float scale = 1.f) {
+template <typename Floats>  // std::vector<float> or a tensor's TensorData
+void fill_random(Floats& v, std::mt19937& rng, float scale = 1.f) {
   std::normal_distribution<float> d(0.f, scale);
   for (float& x : v) x = d(rng);
 }

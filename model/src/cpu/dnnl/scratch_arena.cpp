@@ -34,6 +34,21 @@ dnnl::memory ScratchArena::make(const dnnl::memory::desc& desc) {
   return m;
 }
 
+void ScratchArena::make_tensor(Tensor& tensor, int h, int w, int c) {
+  tensor.h = h;
+  tensor.w = w;
+  tensor.c = c;
+  tensor.data = TensorData();
+  make(nhwc_desc(h, w, c));
+  bindings_.back().tensor = &tensor;
+}
+
+void ScratchArena::release(const Tensor& tensor) {
+  const auto b = std::find_if(bindings_.begin(), bindings_.end(), [&](const Binding& x) { return x.tensor == &tensor; });
+  if (b == bindings_.end()) throw std::logic_error("ScratchArena: release() of a tensor it did not make");
+  release(b->memory);
+}
+
 void ScratchArena::release(const dnnl::memory& memory) {
   const auto b = std::find_if(bindings_.begin(), bindings_.end(),
                               [&](const Binding& x) { return x.memory.get() == memory.get(); });
@@ -73,7 +88,10 @@ void ScratchArena::reserve_workspace(std::size_t bytes) {
 void ScratchArena::finalize() {
   storage_.reset(new std::byte[size_ + workspace_size_ + kAlignment]);
   auto* base = reinterpret_cast<std::byte*>(align_up(reinterpret_cast<std::size_t>(storage_.get())));
-  for (auto& b : bindings_) b.memory.set_data_handle(base + b.offset);
+  for (auto& b : bindings_) {
+    b.memory.set_data_handle(base + b.offset);
+    if (b.tensor) b.tensor->data.view(static_cast<float*>(static_cast<void*>(base + b.offset)), b.tensor->pixels() * b.tensor->c);
+  }
   workspace_ = base + align_up(size_);
 }
 

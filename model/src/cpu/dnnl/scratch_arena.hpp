@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "tensor.hpp"
+
 namespace neuflow::model {
 
 class ScratchArena {
@@ -19,8 +21,14 @@ class ScratchArena {
   // A memory in the current region (no storage until finalize()).
   dnnl::memory make(const dnnl::memory::desc& desc);
 
+  // A stage's own NHWC tensor in the current region: `tensor` takes the shape h×w×c now and
+  // becomes a view of its buffer when finalize() runs, so it must not move before then. What
+  // it holds lasts only while its stage runs (later stages' buffers share the memory).
+  void make_tensor(Tensor& tensor, int h, int w, int c);
+
   // `memory` (made in the current region) is read by nothing built after this point.
   void release(const dnnl::memory& memory);
+  void release(const Tensor& tensor);
 
   // Buffers made after this may overlap those of earlier regions. `name` says whose they are.
   void next_region(std::string name = {});
@@ -53,6 +61,7 @@ class ScratchArena {
     std::size_t size;
     std::size_t region;
     bool released = false;
+    Tensor* tensor = nullptr;  // bound to the memory by finalize()
   };
   struct Span {
     std::size_t offset, size;

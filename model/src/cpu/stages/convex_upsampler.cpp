@@ -15,8 +15,10 @@ constexpr int kNeighbours = 9;
 }  // namespace
 
 ConvexUpsampler::ConvexUpsampler(const NetworkWeights& w, int h8, int w8, PlanContext& context)
-    : input_(h8, w8, 130), mask_head_(&w.upsample_conv3) {
+    : mask_head_(&w.upsample_conv3) {
+  context.arena.make_tensor(input_, h8, w8, 130);  // [flow 2, image features 128], written whole by run()
   conv1_.emplace(w.upsample_conv1, ConvParams{1, 1, Activation::relu}, nhwc_desc(h8, w8, 130), context);
+  context.arena.release(input_);  // read by conv1 only
   conv2_.emplace(w.upsample_conv2, ConvParams{1, 1, Activation::relu}, conv1_->output_desc(), context,
                  nhwc_desc(h8, w8, w.upsample_conv2.out_channels));
   // Bands of about 1 MiB of logits: a few coarse rows, always whole rows.

@@ -4,6 +4,7 @@
 // rows, so memory stays O(L · block) instead of O(L²).
 #include <dnnl.hpp>
 
+#include "dnnl/plan_context.hpp"
 #include "tensor.hpp"
 #include "weights.hpp"
 
@@ -11,7 +12,8 @@ namespace neuflow::model {
 
 class CrossAttention {
  public:
-  CrossAttention(const NetworkWeights& weights, int h16, int w16);
+  // Its buffers come from the current region of the context's arena.
+  CrossAttention(const NetworkWeights& weights, int h16, int w16, PlanContext& context);
 
   // f16_0, f16_1: [h16, w16, 192] backbone outputs; out0/out1 receive the normalized results.
   void run(dnnl::stream& stream, const Tensor& f16_0, const Tensor& f16_1, Tensor& out0, Tensor& out1);
@@ -23,7 +25,7 @@ class CrossAttention {
   const NetworkWeights& weights_;
   int tokens_;
   int block_rows_;
-  std::vector<float> q_, k_, v_, scores_, message_, mlp_in_, mlp_hidden_, state0_, state1_;
+  Tensor q_, k_, v_, scores_, message_, mlp_in_, mlp_hidden_, state0_, state1_;  // [1, rows, cols]
 };
 
 }  // namespace neuflow::model

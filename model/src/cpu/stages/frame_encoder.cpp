@@ -42,21 +42,24 @@ const dnnl::memory& FrameEncoder::run_block(dnnl::stream& stream, Block& b, cons
 
 FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, PlanContext& context)
     : height_(height), width_(width) {
-  half_.resize(height / 2, width / 2, 3);
-  quarter_.resize(height / 4, width / 4, 3);
-  eighth_.resize(height / 8, width / 8, 3);
   // Built in the order run() runs them, each buffer released once what reads it is built, so
   // the region holds only what is alive at once (at 1920×1088 the 1/8 tensors are 130 KB a
-  // channel).
+  // channel). The pooled images are made first: run() computes all three before any block.
   ScratchArena& arena = context.arena;
+  arena.make_tensor(half_, height / 2, width / 2, 3);
+  arena.make_tensor(quarter_, height / 4, width / 4, 3);
+  arena.make_tensor(eighth_, height / 8, width / 8, 3);
   block_8_1_ = make_block(w.block_8_1, 4, 2, nhwc_desc(height / 2, width / 2, 3), context);
+  arena.release(half_);
   block_8_2_ = make_block(w.block_8_2, 2, 2, nhwc_desc(height / 4, width / 4, 3), context);
+  arena.release(quarter_);
   concat_8_ = make_concat(block_8_1_.conv2->output_desc(), block_8_2_.conv2->output_desc(), cat8_, context);
   arena.release(block_8_1_.conv2->output());
   arena.release(block_8_2_.conv2->output());
   block_cat_8_ = make_block(w.block_cat_8, 1, 1, cat8_.get_desc(), context);
   arena.release(cat8_);
   block_16_1_ = make_block(w.block_16_1, 2, 2, nhwc_desc(height / 8, width / 8, 3), context);
+  arena.release(eighth_);
   block_8_16_ = make_block(w.block_8_16, 2, 2, block_cat_8_.conv2->output_desc(), context);
   arena.release(block_cat_8_.conv2->output());  // f8: read by to_nhwc and block_8_16
   concat_16_ = make_concat(block_16_1_.conv2->output_desc(), block_8_16_.conv2->output_desc(), cat16_, context);
@@ -64,7 +67,9 @@ FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, PlanC
   arena.release(block_8_16_.conv2->output());
   block_cat_16_ = make_block(w.block_cat_16, 1, 1, cat16_.get_desc(), context);
   arena.release(cat16_);
+  arena.make_tensor(g_, height / 16, width / 16, block_cat_16_.conv2->out_channels());  // NHWC copy of the output
   arena.release(block_cat_16_.conv2->output());  // read by to_nhwc before conv_s8 runs
+  arena.release(g_);                             // read into f16 before conv_s8 runs
   conv_s8_ = make_block(w.conv_s8, 8, 0, nhwc_desc(height, width, 3), context);
 }
 

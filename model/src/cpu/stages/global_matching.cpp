@@ -10,22 +10,23 @@ namespace neuflow::model {
 namespace {
 constexpr int kScoreBlockFloats = 1 << 20;
 
-void gather(const ChannelSlice& f, std::vector<float>& out) {
+void gather(const ChannelSlice& f, Tensor& out) {
   const int c = f.channels;
   for (int y = 0; y < f.h(); ++y) {
     for (int x = 0; x < f.w(); ++x) {
-      std::copy_n(f.pixel(y, x), c, out.data() + (static_cast<std::size_t>(y) * f.w() + x) * c);
+      std::copy_n(f.pixel(y, x), c, out.data.data() + (static_cast<std::size_t>(y) * f.w() + x) * c);
     }
   }
 }
 }  // namespace
 
-GlobalMatching::GlobalMatching(int h16, int w16, int channels) : h_(h16), w_(w16), channels_(channels) {
+GlobalMatching::GlobalMatching(int h16, int w16, int channels, PlanContext& context)
+    : h_(h16), w_(w16), channels_(channels) {
   const int l = h16 * w16;
   block_rows_ = std::clamp(kScoreBlockFloats / std::max(l, 1), 1, l);
-  a_.resize(static_cast<std::size_t>(l) * channels);
-  b_.resize(static_cast<std::size_t>(l) * channels);
-  scores_.resize(static_cast<std::size_t>(block_rows_) * l);
+  context.arena.make_tensor(a_, 1, l, channels);
+  context.arena.make_tensor(b_, 1, l, channels);
+  context.arena.make_tensor(scores_, 1, block_rows_, l);
   correspondence_.resize(static_cast<std::size_t>(l) * 2);
   grid_.resize(static_cast<std::size_t>(l) * 2);
   for (int y = 0; y < h16; ++y) {
@@ -43,10 +44,10 @@ void GlobalMatching::run(dnnl::stream& stream, const ChannelSlice& f0, const Cha
   const float alpha = 1.f / std::sqrt(static_cast<float>(channels_));
   for (int r0 = 0; r0 < l; r0 += block_rows_) {
     const int n = std::min(block_rows_, l - r0);
-    matmul(stream, {a_.data() + static_cast<std::size_t>(r0) * channels_, n, channels_, channels_},
-           {b_.data(), l, channels_, channels_}, scores_.data(), l, {.transpose_b = true, .alpha = alpha});
-    softmax_rows(stream, scores_.data(), n, l);
-    matmul(stream, {scores_.data(), n, l, l}, {grid_.data(), l, 2, 2}, correspondence_.data() + 2 * r0, 2);
+    matmul(stream, {a_.data.data() + static_cast<std::size_t>(r0) * channels_, n, channels_, channels_},
+           {b_.data.data(), l, channels_, channels_}, scores_.data.data(), l, {.transpose_b = true, .alpha = alpha});
+    softmax_rows(stream, scores_.data.data(), n, l);
+    matmul(stream, {scores_.data.data(), n, l, l}, {grid_.data(), l, 2, 2}, correspondence_.data() + 2 * r0, 2);
   }
   stream.wait();
   flow.resize(h_, w_, 2);

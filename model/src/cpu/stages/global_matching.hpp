@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include "dnnl/plan_context.hpp"
 #include "ops/feature_ops.hpp"
 #include "tensor.hpp"
 
@@ -13,14 +14,16 @@ namespace neuflow::model {
 
 class GlobalMatching {
  public:
-  GlobalMatching(int h16, int w16, int channels);
+  // The features' copies and the score block come from the current region of the context's arena.
+  GlobalMatching(int h16, int w16, int channels, PlanContext& context);
 
   // f0, f1: [h16, w16, channels] features; flow receives [h16, w16, 2] (x, y displacement).
   void run(dnnl::stream& stream, const ChannelSlice& f0, const ChannelSlice& f1, Tensor& flow);
 
  private:
   int h_, w_, channels_, block_rows_;
-  std::vector<float> a_, b_, grid_, scores_, correspondence_;
+  Tensor a_, b_, scores_;  // [1, rows, cols]
+  std::vector<float> grid_, correspondence_;
 };
 
 }  // namespace neuflow::model

@@ -13,11 +13,12 @@ constexpr int kFlowOffset = kCorrChannels + kHiddenChannels;
 constexpr float kHiddenClamp = 4.f;
 }  // namespace
 
-Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& context)
-    : input_(h, width, kRefineDynamicChannels),
-      constant_(h, width, kRefineConstantChannels),
-      hidden_(h, width, kHiddenChannels),
-      delta_(h, width, 2) {
+Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& context) {
+  // In the arena: begin() and step() write each of them whole before anything reads it.
+  context.arena.make_tensor(input_, h, width, kRefineDynamicChannels);
+  context.arena.make_tensor(constant_, h, width, kRefineConstantChannels);
+  context.arena.make_tensor(hidden_, h, width, kHiddenChannels);
+  context.arena.make_tensor(delta_, h, width, 2);
   conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c), context);
   conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), context,
                           conv1_->output_desc());
@@ -38,6 +39,7 @@ Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& co
     prev = &*layers_[i];
   }
   conv3_.emplace(w.conv3, ConvParams{1, 1, Activation::none}, prev->output_desc(), context);
+  arena.make_tensor(output_, h, width, w.conv3.out_channels);  // written while conv3 runs
   conv3_->release_scratch(arena);
   arena.release(prev->output());
 }

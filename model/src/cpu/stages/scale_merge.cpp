@@ -4,8 +4,9 @@
 
 namespace neuflow::model {
 
-ScaleMerge::ScaleMerge(const NetworkWeights& w, int h8, int w8, PlanContext& context)
-    : feature_input_(h8, w8, 256), context_input_(h8, w8, 128) {
+ScaleMerge::ScaleMerge(const NetworkWeights& w, int h8, int w8, PlanContext& context) {
+  context.arena.make_tensor(feature_input_, h8, w8, 256);
+  context.arena.make_tensor(context_input_, h8, w8, 128);
   merge0_.emplace(w.merge_s8_0, ConvParams{1, 1, Activation::gelu}, nhwc_desc(h8, w8, 256), context);
   merge2_.emplace(w.merge_s8_2, ConvParams{1, 1, Activation::none}, merge0_->output_desc(), context);
   context0_.emplace(w.context_merge_s8_0, ConvParams{1, 1, Activation::gelu}, nhwc_desc(h8, w8, 128), context);

@@ -22,7 +22,7 @@ class ScaleMerge {
   void merge_context(dnnl::stream& stream, const ChannelSlice& context8, const ChannelSlice& context16, Tensor& out);
 
  private:
-  Tensor feature_input_, context_input_;
+  Tensor feature_input_, context_input_;  // in the arena: rewritten whole by each call
   std::optional<ConvOp> merge0_, merge2_, context0_, context2_;
 };
 
