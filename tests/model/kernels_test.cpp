@@ -147,28 +147,56 @@ INSTANTIATE_TEST_SUITE_P(NetworkShapes, ConvOpTest,
                                            ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd)));
 
 // The arena reuses a released buffer's bytes for buffers made afterwards in the same region,
-// merges neighbouring released spans, and never lets two unreleased buffers overlap.
-TEST(ScratchArena, ReleasedSpansAreReusedAndLiveBuffersNeverOverlap) {
+// never lets two buffers alive at the same time overlap, and places the largest first: here a
+// buffer made after a small one is released does not fit that one's bytes, and placing buffers
+// as they came would have put it after both (16 KiB), where largest-first needs 12 KiB.
+TEST(ScratchArena, LiveBuffersNeverOverlapAndTheLargestArePlacedFirst) {
   const auto floats = [](int n) { return dnnl::memory::desc({n}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::a); };
   ScratchArena arena;
-  const dnnl::memory a = arena.make(floats(1024)), b = arena.make(floats(1024)), c = arena.make(floats(1024));
+  const dnnl::memory a = arena.make(floats(1024)), b = arena.make(floats(1024));
   arena.release(a);
-  arena.release(b);  // merged with a: 8 KiB free at the start
-  const dnnl::memory d = arena.make(floats(2048));  // fits the merged span exactly
-  const dnnl::memory e = arena.make(floats(16));    // nothing free: after c
-  EXPECT_EQ(arena.regions().back().bytes, 3 * 4096u + 64u);
+  const dnnl::memory c = arena.make(floats(2048));  // alive with b, not with a
   EXPECT_THROW(arena.release(a), std::logic_error);  // twice
+  Tensor t;
+  arena.make_tensor(t, 2, 4, 8);  // 256 bytes, alive with b and c
   arena.next_region("second");
   EXPECT_THROW(arena.release(c), std::logic_error);  // of an earlier region
   const dnnl::memory f = arena.make(floats(4096));   // overlaps the first region: allowed
   arena.finalize();
   const auto at = [](const dnnl::memory& m) { return static_cast<const char*>(m.get_data_handle()); };
-  EXPECT_EQ(at(d), at(a));
-  EXPECT_GE(at(e), at(c) + 4096);
+  EXPECT_EQ(at(c), at(a));              // largest first, at 0; a (not alive with it) there too
+  EXPECT_EQ(at(b), at(c) + 8192);       // b lives with c
+  EXPECT_EQ(reinterpret_cast<const char*>(t.data.data()), at(b) + 4096);
+  EXPECT_TRUE(t.data.is_view());
+  EXPECT_EQ(t.data.size(), 64u);
   EXPECT_EQ(at(f), at(a));
   EXPECT_EQ(arena.regions().size(), 2u);
+  EXPECT_EQ(arena.regions()[0].bytes, 3 * 4096u + 256u);
   EXPECT_EQ(arena.regions()[1].name, "second");
   EXPECT_EQ(arena.size_bytes(), 16384u);
+}
+
+// A tensor of the arena: its copy owns its floats, a move keeps the view, and resizing it to
+// its own shape keeps it in the arena.
+TEST(ScratchArena, TensorsStayViewsOfTheArenaAndCopiesOwnTheirFloats) {
+  ScratchArena arena;
+  Tensor t;
+  arena.make_tensor(t, 3, 5, 2);
+  arena.finalize();
+  float* where = t.data.data();
+  t.pixel(2, 4)[1] = 7.f;
+  Tensor copy = t;
+  EXPECT_FALSE(copy.data.is_view());
+  EXPECT_NE(copy.data.data(), where);
+  EXPECT_EQ(copy.pixel(2, 4)[1], 7.f);
+  t.resize(3, 5, 2);
+  EXPECT_EQ(t.data.data(), where);
+  EXPECT_EQ(t.pixel(2, 4)[1], 0.f);
+  Tensor moved = std::move(t);
+  EXPECT_EQ(moved.data.data(), where);
+  moved.resize(4, 5, 2);  // another size: its own floats, the arena's untouched
+  EXPECT_FALSE(moved.data.is_view());
+  EXPECT_NE(moved.data.data(), where);
 }
 
 }  // namespace

@@ -15,21 +15,7 @@ std::size_t align_up(std::size_t v) { return (v + kAlignment - 1) / kAlignment *
 dnnl::memory ScratchArena::make(const dnnl::memory::desc& desc) {
   if (storage_) throw std::logic_error("ScratchArena: make() after finalize()");
   dnnl::memory m(desc, cpu_engine(), DNNL_MEMORY_NONE);
-  const std::size_t size = align_up(desc.get_size());
-  // The first released span it fits in, else the region's end.
-  std::size_t offset = region_end_;
-  const auto fit = std::find_if(free_.begin(), free_.end(), [&](const Span& f) { return f.size >= size; });
-  if (fit != free_.end()) {
-    offset = fit->offset;
-    fit->offset += size;
-    fit->size -= size;
-    if (fit->size == 0) free_.erase(fit);
-  } else {
-    region_end_ += size;
-  }
-  bindings_.push_back({m, offset, size, regions_.size() - 1});
-  size_ = std::max(size_, region_end_);
-  regions_.back().bytes = std::max(regions_.back().bytes, region_end_);
+  bindings_.push_back({m, align_up(desc.get_size()), regions_.size() - 1, events_++});
   ++regions_.back().buffers;
   return m;
 }
@@ -53,30 +39,13 @@ void ScratchArena::release(const dnnl::memory& memory) {
   const auto b = std::find_if(bindings_.begin(), bindings_.end(),
                               [&](const Binding& x) { return x.memory.get() == memory.get(); });
   if (b == bindings_.end()) throw std::logic_error("ScratchArena: release() of a memory it did not make");
-  if (b->region != regions_.size() - 1 || b->released) {
+  if (b->region != regions_.size() - 1 || b->released != kForever) {
     throw std::logic_error("ScratchArena: release() of a memory of an earlier region, or twice");
   }
-  b->released = true;
-  Span span{b->offset, b->size};
-  // Merged with its free neighbours, so larger buffers fit later.
-  auto at = std::lower_bound(free_.begin(), free_.end(), span.offset,
-                             [](const Span& f, std::size_t offset) { return f.offset < offset; });
-  at = free_.insert(at, span);
-  if (at + 1 != free_.end() && at->offset + at->size == (at + 1)->offset) {
-    at->size += (at + 1)->size;
-    free_.erase(at + 1);
-  }
-  if (at != free_.begin() && (at - 1)->offset + (at - 1)->size == at->offset) {
-    (at - 1)->size += at->size;
-    free_.erase(at);
-  }
+  b->released = events_++;
 }
 
-void ScratchArena::next_region(std::string name) {
-  region_end_ = 0;
-  free_.clear();
-  regions_.push_back({std::move(name), 0, 0});
-}
+void ScratchArena::next_region(std::string name) { regions_.push_back({std::move(name), 0, 0}); }
 
 void ScratchArena::name_region(std::string name) { regions_.back().name = std::move(name); }
 
@@ -85,7 +54,36 @@ void ScratchArena::reserve_workspace(std::size_t bytes) {
   workspace_size_ = std::max(workspace_size_, align_up(bytes));
 }
 
+void ScratchArena::place_region(std::size_t region) {
+  std::vector<Binding*> order;
+  for (auto& b : bindings_) {
+    if (b.region == region) order.push_back(&b);
+  }
+  std::stable_sort(order.begin(), order.end(), [](const Binding* a, const Binding* b) { return a->size > b->size; });
+  std::vector<const Binding*> placed;
+  std::size_t end = 0;
+  for (Binding* b : order) {
+    // The placed buffers alive at some moment of b's life, by offset; b takes the first gap.
+    std::vector<const Binding*> clashes;
+    for (const Binding* p : placed) {
+      if (p->made < b->released && b->made < p->released) clashes.push_back(p);
+    }
+    std::sort(clashes.begin(), clashes.end(), [](const Binding* x, const Binding* y) { return x->offset < y->offset; });
+    std::size_t offset = 0;
+    for (const Binding* c : clashes) {
+      if (c->offset >= offset + b->size) break;
+      offset = std::max(offset, c->offset + c->size);
+    }
+    b->offset = offset;
+    end = std::max(end, offset + b->size);
+    placed.push_back(b);
+  }
+  regions_[region].bytes = end;
+  size_ = std::max(size_, end);
+}
+
 void ScratchArena::finalize() {
+  for (std::size_t r = 0; r < regions_.size(); ++r) place_region(r);
   storage_.reset(new std::byte[size_ + workspace_size_ + kAlignment]);
   auto* base = reinterpret_cast<std::byte*>(align_up(reinterpret_cast<std::size_t>(storage_.get())));
   for (auto& b : bindings_) {
