@@ -19,7 +19,7 @@ struct FlowSession::State {
   std::shared_ptr<VulkanContext> vulkan;  // set while the session runs on a Vulkan device
   std::string description = "cpu";
   std::string fallback;
-  Tensor input, model_flow;
+  Tensor input;  // a frame converted here, for a backend that does not convert it itself
   int previous_slot = 0;
   bool has_previous = false;
   StageObserver observer;
@@ -142,9 +142,9 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   check_image(frame1, g);
   encode(s, frame0, g, options_.network_order, first);
   encode(s, frame1, g, options_.network_order, second);
-  s.backend->flow(first, second, iterations, s.model_flow, &s.observer);
+  const Tensor& model_flow = s.backend->flow(first, second, iterations, &s.observer);
   keep_stage_times(s);
-  return restore_flow(s.model_flow, g);
+  return restore_flow(model_flow, g);
 }
 
 std::optional<flow::FlowField> FlowSession::push(const ImageView& frame) { return push(frame, options_.iterations); }
@@ -163,8 +163,7 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   encode(s, frame, g, options_.network_order, current);
   std::optional<flow::FlowField> result;
   if (s.has_previous) {
-    s.backend->flow(s.previous_slot, current, iterations, s.model_flow, &s.observer);
-    result = restore_flow(s.model_flow, g);
+    result = restore_flow(s.backend->flow(s.previous_slot, current, iterations, &s.observer), g);
   }
   keep_stage_times(s);
   s.previous_slot = current;

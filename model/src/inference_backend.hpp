@@ -33,10 +33,10 @@ class InferenceBackend {
                             ChannelOrder /*network_order*/, int /*slot*/) {
     return false;
   }
-  // Flow from the frame in slot0 to the frame in slot1: [height, width, 2] (u, v). The
-  // observer, when set, sees every named stage (the same names on every backend).
-  virtual void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,
-                    const StageObserver* observer) = 0;
+  // Flow from the frame in slot0 to the frame in slot1: [height, width, 2] (u, v), in the
+  // backend's own memory until its next call. The observer, when set, sees every named stage
+  // (the same names on every backend).
+  virtual const Tensor& flow(int slot0, int slot1, const Iterations& iterations, const StageObserver* observer) = 0;
   // The device's own time for each stage of the passes since the last call, where the backend
   // measures one (the GPU's timestamps); the CPU's stages are timed with an observer instead.
   virtual std::vector<StageTime> take_stage_times() { return {}; }

@@ -16,9 +16,16 @@ class CpuBackend final : public InferenceBackend {
   int width() const override { return plan_.width(); }
   int height() const override { return plan_.height(); }
   void encode(const Tensor& image, int slot) override { plan_.encode(stream_, image, slots_[static_cast<std::size_t>(slot)]); }
-  void flow(int slot0, int slot1, const Iterations& iterations, Tensor& out, const StageObserver* observer) override {
-    plan_.flow(stream_, slots_[static_cast<std::size_t>(slot0)], slots_[static_cast<std::size_t>(slot1)], iterations.s16,
-               iterations.s8, out, observer);
+  // Converted into the plan's arena rather than a tensor of the session's (25 MB at 1920×1088).
+  bool encode_frame(const ImageView& image, const FrameGeometry& geometry, ChannelOrder network_order,
+                    int slot) override {
+    prepare_input(image, geometry, network_order, plan_.input());
+    encode(plan_.input(), slot);
+    return true;
+  }
+  const Tensor& flow(int slot0, int slot1, const Iterations& iterations, const StageObserver* observer) override {
+    return plan_.flow(stream_, slots_[static_cast<std::size_t>(slot0)], slots_[static_cast<std::size_t>(slot1)],
+                      iterations.s16, iterations.s8, observer);
   }
 
  private:

@@ -52,8 +52,8 @@ void NetworkPlan::encode(dnnl::stream& stream, const Tensor& image, FrameFeature
   stream.wait();
 }
 
-void NetworkPlan::flow(dnnl::stream& stream, const FrameFeatures& f0, const FrameFeatures& f1, int iters_s16,
-                       int iters_s8, Tensor& out, const StageObserver* observer) {
+const Tensor& NetworkPlan::flow(dnnl::stream& stream, const FrameFeatures& f0, const FrameFeatures& f1,
+                                int iters_s16, int iters_s8, const StageObserver* observer) {
   observe(observer, "backbone_s16", 0, f0.f16);
   observe(observer, "backbone_s16", 1, f1.f16);
   observe(observer, "backbone_s8", 0, f0.f8);
@@ -101,8 +101,9 @@ void NetworkPlan::flow(dnnl::stream& stream, const FrameFeatures& f0, const Fram
     }
   }
 
-  upsampler_.run(stream, flow8_, f0.upsample_features, out);
+  const Tensor& out = upsampler_.run(stream, flow8_, f0.upsample_features);
   observe(observer, "flow", 0, out);
+  return out;
 }
 
 }  // namespace neuflow::model

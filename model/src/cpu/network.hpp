@@ -30,10 +30,13 @@ class NetworkPlan {
 
   // image: [height, width, 3] RGB in 0..1.
   void encode(dnnl::stream& stream, const Tensor& image, FrameFeatures& out);
+  // Where a frame may be converted before encode(): a tensor of the arena, see FrameEncoder::input().
+  Tensor& input() { return encoder_.input(); }
 
-  // Flow from frame 0 to frame 1 at model resolution: [height, width, 2] (u, v) in pixels.
-  void flow(dnnl::stream& stream, const FrameFeatures& frame0, const FrameFeatures& frame1, int iters_s16,
-            int iters_s8, Tensor& out, const StageObserver* observer = nullptr);
+  // Flow from frame 0 to frame 1 at model resolution: [height, width, 2] (u, v) in pixels, in
+  // the arena: valid until the plan's next call.
+  const Tensor& flow(dnnl::stream& stream, const FrameFeatures& frame0, const FrameFeatures& frame1, int iters_s16,
+                     int iters_s8, const StageObserver* observer = nullptr);
 
  private:
   int height_, width_;

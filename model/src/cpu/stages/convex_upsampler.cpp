@@ -18,9 +18,14 @@ ConvexUpsampler::ConvexUpsampler(const NetworkWeights& w, int h8, int w8, PlanCo
     : mask_head_(&w.upsample_conv3) {
   context.arena.make_tensor(input_, h8, w8, 130);  // [flow 2, image features 128], written whole by run()
   conv1_.emplace(w.upsample_conv1, ConvParams{1, 1, Activation::relu}, nhwc_desc(h8, w8, 130), context);
+  conv1_->release_scratch(context.arena);
   context.arena.release(input_);  // read by conv1 only
   conv2_.emplace(w.upsample_conv2, ConvParams{1, 1, Activation::relu}, conv1_->output_desc(), context,
                  nhwc_desc(h8, w8, w.upsample_conv2.out_channels));
+  conv2_->release_scratch(context.arena);
+  context.arena.release(conv1_->output());  // read by conv2 only
+  // Written, band by band, while conv2's output is read: made after it, so never on it.
+  context.arena.make_tensor(flow_, h8 * kFactor, w8 * kFactor, 2);
   // Bands of about 1 MiB of logits: a few coarse rows, always whole rows.
   constexpr std::size_t kBandBytes = 1 << 20;
   const std::size_t row_bytes = static_cast<std::size_t>(w8) * kNeighbours * kFactor * kFactor * sizeof(float);
@@ -28,7 +33,8 @@ ConvexUpsampler::ConvexUpsampler(const NetworkWeights& w, int h8, int w8, PlanCo
   band_.resize(static_cast<std::size_t>(band_rows_) * w8 * kNeighbours * kFactor * kFactor);
 }
 
-void ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tensor& image_features, Tensor& flow) {
+const Tensor& ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tensor& image_features) {
+  Tensor& flow = flow_;
   copy_channels(all_channels(flow8), input_, 0);
   copy_channels(all_channels(image_features), input_, 2);
   const auto& features_memory = conv2_->run(stream, conv1_->run(stream, wrap_nhwc(input_)));
@@ -38,7 +44,6 @@ void ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tenso
   const int depth = mask_head_->in_channels;
   constexpr int kWeights = kFactor * kFactor;           // output pixels per coarse pixel
   constexpr int kLogits = kNeighbours * kWeights;       // channel k · 64 + a · 8 + b
-  flow.resize(h8 * kFactor, w8 * kFactor, 2);
   for (int y0 = 0; y0 < h8; y0 += band_rows_) {
     const int rows = std::min(band_rows_, h8 - y0);
     const int pixels = rows * w8;
@@ -93,6 +98,7 @@ void ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, const Tenso
       }
     }
   }
+  return flow_;
 }
 
 }  // namespace neuflow::model

@@ -20,10 +20,11 @@ class ConvexUpsampler {
   ConvexUpsampler(const NetworkWeights& weights, int h8, int w8, PlanContext& context);
 
   // flow8 [h8, w8, 2], image_features [h8, w8, 128] (conv_s8 of frame 0) → flow [8·h8, 8·w8, 2].
-  void run(dnnl::stream& stream, const Tensor& flow8, const Tensor& image_features, Tensor& flow);
+  // The result is in the arena, valid until another stage runs.
+  const Tensor& run(dnnl::stream& stream, const Tensor& flow8, const Tensor& image_features);
 
  private:
-  Tensor input_;
+  Tensor input_, flow_;
   std::optional<ConvOp> conv1_, conv2_;  // conv2 writes NHWC: rows of 512 features per pixel
   const ConvWeights* mask_head_;          // the 1×1 512 → 576 layer, [576][512] row-major
   int band_rows_;

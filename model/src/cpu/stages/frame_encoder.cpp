@@ -46,9 +46,15 @@ FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, PlanC
   // the region holds only what is alive at once (at 1920×1088 the 1/8 tensors are 130 KB a
   // channel). The pooled images are made first: run() computes all three before any block.
   ScratchArena& arena = context.arena;
+  arena.make_tensor(input_, height, width, 3);
   arena.make_tensor(half_, height / 2, width / 2, 3);
   arena.make_tensor(quarter_, height / 4, width / 4, 3);
   arena.make_tensor(eighth_, height / 8, width / 8, 3);
+  // conv_s8 first: the full-resolution image (25 MB at 1920×1088) is then no longer needed
+  // when the 1/8 concatenation, the encoder's largest moment, is alive.
+  conv_s8_ = make_block(w.conv_s8, 8, 0, nhwc_desc(height, width, 3), context);
+  arena.release(input_);
+  arena.release(conv_s8_.conv2->output());  // read by to_nhwc before the next block runs
   block_8_1_ = make_block(w.block_8_1, 4, 2, nhwc_desc(height / 2, width / 2, 3), context);
   arena.release(half_);
   block_8_2_ = make_block(w.block_8_2, 2, 2, nhwc_desc(height / 4, width / 4, 3), context);
@@ -68,9 +74,8 @@ FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, PlanC
   block_cat_16_ = make_block(w.block_cat_16, 1, 1, cat16_.get_desc(), context);
   arena.release(cat16_);
   arena.make_tensor(g_, height / 16, width / 16, block_cat_16_.conv2->out_channels());  // NHWC copy of the output
-  arena.release(block_cat_16_.conv2->output());  // read by to_nhwc before conv_s8 runs
-  arena.release(g_);                             // read into f16 before conv_s8 runs
-  conv_s8_ = make_block(w.conv_s8, 8, 0, nhwc_desc(height, width, 3), context);
+  arena.release(block_cat_16_.conv2->output());  // read by to_nhwc only
+  arena.release(g_);                             // read into f16, the last step
 }
 
 void FrameEncoder::run(dnnl::stream& stream, const Tensor& image, FrameFeatures& out) {
@@ -78,6 +83,8 @@ void FrameEncoder::run(dnnl::stream& stream, const Tensor& image, FrameFeatures&
   avg_pool_2x(half_, quarter_);
   avg_pool_2x(quarter_, eighth_);
   auto half = wrap_nhwc(half_), quarter = wrap_nhwc(quarter_), eighth = wrap_nhwc(eighth_);
+  auto full = dnnl::memory(nhwc_desc(image.h, image.w, 3), cpu_engine(), const_cast<float*>(image.data.data()));
+  to_nhwc(stream, run_block(stream, conv_s8_, full), out.upsample_features);
 
   const auto& a = run_block(stream, block_8_1_, half);
   const auto& b = run_block(stream, block_8_2_, quarter);
@@ -103,8 +110,6 @@ void FrameEncoder::run(dnnl::stream& stream, const Tensor& image, FrameFeatures&
     }
   }
 
-  auto full = dnnl::memory(nhwc_desc(image.h, image.w, 3), cpu_engine(), const_cast<float*>(image.data.data()));
-  to_nhwc(stream, run_block(stream, conv_s8_, full), out.upsample_features);
 }
 
 }  // namespace neuflow::model

@@ -23,8 +23,12 @@ class FrameEncoder {
   // height and width: the model resolution, multiples of 16.
   FrameEncoder(const NetworkWeights& weights, int height, int width, PlanContext& context);
 
-  // image: [height, width, 3], RGB scaled to 0..1.
+  // image: [height, width, 3], RGB scaled to 0..1; input() or a tensor of the caller's.
   void run(dnnl::stream& stream, const Tensor& image, FrameFeatures& out);
+
+  // [height, width, 3] in the arena, for a frame converted straight into it: alive only until
+  // run() has read it.
+  Tensor& input() { return input_; }
 
  private:
   struct Block {
@@ -35,7 +39,7 @@ class FrameEncoder {
   const dnnl::memory& run_block(dnnl::stream& stream, Block& b, const dnnl::memory& input);
 
   int height_, width_;
-  Tensor half_, quarter_, eighth_, g_;
+  Tensor input_, half_, quarter_, eighth_, g_;
   Block block_8_1_, block_8_2_, block_cat_8_, block_16_1_, block_8_16_, block_cat_16_, conv_s8_;
   std::optional<dnnl::concat> concat_8_, concat_16_;
   dnnl::memory cat8_, cat16_;
