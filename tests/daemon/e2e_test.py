@@ -441,7 +441,9 @@ class DaemonFailures(DaemonTestCase):
 
     def test_a_lost_gpu_restarts_its_stream_on_a_new_device_while_the_others_run(self):
         # NEUFLOW_VULKAN_LOSE_DEVICE_AFTER stands in for a GPU hang or reset: every device
-        # neuflowd opens reports itself lost at its sixth submission. The stream on it fails
+        # neuflowd opens reports itself lost at its 12th submission (at its sixth, with both
+        # cores busy, a device was once lost in every life before a flow reached the sink,
+        # frames being dropped to hold the rate). The stream on it fails
         # naming the device, backs off and plays again on a newly opened device, more than once;
         # the CPU stream goes on producing.
         if os.environ.get("NEUFLOW_REQUIRE_VULKAN", "0") in ("", "0") and shutil.which("vulkaninfo") is None:
@@ -453,7 +455,7 @@ class DaemonFailures(DaemonTestCase):
                              flow='  backend = "vulkan"\n  device = 0\n') +
                 stream_block("good", test_source(), [f'  type = "files"\n  directory = "{good}"'],
                              flow='  backend = "cpu"\n'))
-        extra = {"NEUFLOW_VULKAN_LOSE_DEVICE_AFTER": "5"}
+        extra = {"NEUFLOW_VULKAN_LOSE_DEVICE_AFTER": "11"}
         if os.environ.get("NEUFLOW_E2E_SANITIZED") == "1":  # see the test above
             extra.update({"LSAN_OPTIONS": "", "ASAN_OPTIONS": "detect_leaks=0:abort_on_error=1"})
         d = self.start(text, extra_env=extra)
