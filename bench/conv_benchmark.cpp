@@ -95,9 +95,6 @@ int print_arena(const std::string& model_path, int width, int height) {
     std::printf("%-12s %8d %8.1f %8.0f %8.1f %8.0f\n", d[i].name.c_str(), d[i].buffers, d[i].bytes / 1e6,
                 d[i].bytes / pixels, w[i].bytes / 1e6, w[i].bytes / pixels);
   }
-  std::printf("%-12s %8s %8.1f %8.0f %8.1f %8.0f\n", "workspace", "", direct.arena().workspace_bytes() / 1e6,
-              direct.arena().workspace_bytes() / pixels, winograd.arena().workspace_bytes() / 1e6,
-              winograd.arena().workspace_bytes() / pixels);
   std::printf("%-12s %8s %8.1f %8.0f %8.1f %8.0f\n", "arena", "", direct.arena().size_bytes() / 1e6,
               direct.arena().size_bytes() / pixels, winograd.arena().size_bytes() / 1e6,
               winograd.arena().size_bytes() / pixels);

@@ -39,8 +39,8 @@ NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width, CpuConv
       attention_(w, height / 16, width / 16, next_region(context_, "cross_attention")),
       matching_(height / 16, width / 16, kFeatures, next_region(context_, "global_matching")),
       refine_s16_(w.refine_s16, height / 16, width / 16, next_region(context_, "refine_s16")),
-      merge_(w, height / 8, width / 8, next_region(context_, "merge_s8")),
-      refine_s8_(w.refine_s8, height / 8, width / 8, next_region(context_, "refine_s8")),
+      merge_(w, height / 8, width / 8, next_region(context_, "merge_refine_s8")),
+      refine_s8_(w.refine_s8, height / 8, width / 8, context_),  // same region: it reads the merges' outputs
       upsampler_(w, height / 8, width / 8, next_region(context_, "upsampler")),
       context16_(height / 16, width / 16, kContext),
       flow8_(height / 8, width / 8, 2) {
@@ -82,17 +82,17 @@ const Tensor& NetworkPlan::flow(dnnl::stream& stream, const FrameFeatures& f0, c
 
   // 1/16 → 1/8.
   upsample_nearest_2x(all_channels(flow16_), flow8_, 0, 2.f);
-  merge_.merge_features(stream, features_of(f0.f8), features_of(attended0_), features8_0_);
-  merge_.merge_features(stream, features_of(f1.f8), features_of(attended1_), features8_1_);
-  observe(observer, "merge_s8", 0, features8_0_);
-  observe(observer, "merge_s8", 1, features8_1_);
-  merge_.merge_context(stream, context_of(f0.f8), context_of(attended0_), context8_);
-  observe(observer, "context_merge_s8", 0, context8_);
+  merge_.merge_features(stream, features_of(f0.f8), features_of(attended0_), 0);
+  merge_.merge_features(stream, features_of(f1.f8), features_of(attended1_), 1);
+  observe(observer, "merge_s8", 0, merge_.features(0));
+  observe(observer, "merge_s8", 1, merge_.features(1));
+  merge_.merge_context(stream, context_of(f0.f8), context_of(attended0_));
+  observe(observer, "context_merge_s8", 0, merge_.context());
 
   // 1/8 refinement.
-  refine_s8_.begin(stream, context8_);
+  refine_s8_.begin(stream, merge_.context());
   for (int i = 0; i < iters_s8; ++i) {
-    refine_s8_.step(stream, all_channels(features8_0_), all_channels(features8_1_), flow8_);
+    refine_s8_.step(stream, all_channels(merge_.features(0)), all_channels(merge_.features(1)), flow8_);
     const std::string it = "_iter" + std::to_string(i);
     if (observer) {
       observe(observer, "corr_s8" + it, 0, extract_channels({&refine_s8_.last_input(), 0, kCorrChannels}));

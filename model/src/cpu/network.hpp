@@ -48,7 +48,7 @@ class NetworkPlan {
   ScaleMerge merge_;
   Refinement refine_s8_;
   ConvexUpsampler upsampler_;
-  Tensor attended0_, attended1_, context16_, flow16_, flow8_, features8_0_, features8_1_, context8_;
+  Tensor attended0_, attended1_, context16_, flow16_, flow8_;
 };
 
 }  // namespace neuflow::model

@@ -38,9 +38,10 @@ class ConvOp {
   bool is_winograd() const { return winograd_.has_value(); }
 
   // Releases to `arena` what this convolution needs only while it runs (an input converted
-  // to its layout); call once the operations after it are built, see ScratchArena::release.
+  // to its layout, the Winograd workspace); see ScratchArena::release.
   void release_scratch(ScratchArena& arena) const {
     if (input_reorder_) arena.release(reordered_input_);
+    if (winograd_) arena.release(winograd_->workspace());
   }
 
  private:

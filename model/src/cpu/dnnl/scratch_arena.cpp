@@ -49,11 +49,6 @@ void ScratchArena::next_region(std::string name) { regions_.push_back({std::move
 
 void ScratchArena::name_region(std::string name) { regions_.back().name = std::move(name); }
 
-void ScratchArena::reserve_workspace(std::size_t bytes) {
-  if (storage_) throw std::logic_error("ScratchArena: reserve_workspace() after finalize()");
-  workspace_size_ = std::max(workspace_size_, align_up(bytes));
-}
-
 void ScratchArena::place_region(std::size_t region) {
   std::vector<Binding*> order;
   for (auto& b : bindings_) {
@@ -84,13 +79,12 @@ void ScratchArena::place_region(std::size_t region) {
 
 void ScratchArena::finalize() {
   for (std::size_t r = 0; r < regions_.size(); ++r) place_region(r);
-  storage_.reset(new std::byte[size_ + workspace_size_ + kAlignment]);
+  storage_.reset(new std::byte[size_ + kAlignment]);
   auto* base = reinterpret_cast<std::byte*>(align_up(reinterpret_cast<std::size_t>(storage_.get())));
   for (auto& b : bindings_) {
     b.memory.set_data_handle(base + b.offset);
     if (b.tensor) b.tensor->data.view(static_cast<float*>(static_cast<void*>(base + b.offset)), b.tensor->pixels() * b.tensor->c);
   }
-  workspace_ = base + align_up(size_);
 }
 
 }  // namespace neuflow::model

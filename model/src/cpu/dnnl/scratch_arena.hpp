@@ -44,17 +44,11 @@ class ScratchArena {
     int buffers = 0;
   };
   const std::vector<Region>& regions() const { return regions_; }
-  std::size_t workspace_bytes() const { return workspace_size_; }
 
   // Allocates the largest region's size once and binds every memory made so far.
   void finalize();
 
-  // Room that one operation uses only while it runs (the Winograd convolutions' transformed
-  // tiles): operations run one at a time, so all share one block of the largest size asked.
-  void reserve_workspace(std::size_t bytes);
-  std::byte* workspace() const { return workspace_; }  // after finalize()
-
-  std::size_t size_bytes() const { return size_ + workspace_size_; }
+  std::size_t size_bytes() const { return size_; }
 
  private:
   struct Binding {
@@ -73,8 +67,6 @@ class ScratchArena {
   std::vector<Region> regions_{1};
   std::size_t events_ = 0;
   std::size_t size_ = 0;
-  std::size_t workspace_size_ = 0;
-  std::byte* workspace_ = nullptr;
   std::unique_ptr<std::byte[]> storage_;
 };
 

@@ -17,17 +17,17 @@ Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& co
   // In the arena: begin() and step() write each of them whole before anything reads it.
   context.arena.make_tensor(input_, h, width, kRefineDynamicChannels);
   context.arena.make_tensor(constant_, h, width, kRefineConstantChannels);
-  context.arena.make_tensor(hidden_, h, width, kHiddenChannels);
-  context.arena.make_tensor(delta_, h, width, 2);
-  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c), context);
-  conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), context,
-                          conv1_->output_desc());
-  // The chain runs in the order it is built, and an iteration hands nothing to the next
-  // through the arena (the hidden state and flow go through input_), so each convolution's
-  // output is released once the next one is built; conv1_constant's stays for the pair.
+  // The chain is built in the order it runs (conv1_constant in begin(), the rest in every
+  // step), and an iteration hands nothing to the next through the arena (the hidden state and
+  // flow go through input_), so each convolution's output is released once the next one is
+  // built; conv1_constant's stays for the pair, and conv1 writes its sum in that layout.
   ScratchArena& arena = context.arena;
-  conv1_->release_scratch(arena);
+  conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), context);
   conv1_constant_->release_scratch(arena);
+  arena.release(constant_);  // read in begin() only
+  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c), context,
+                 conv1_constant_->output_desc());
+  conv1_->release_scratch(arena);
   conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, conv1_->output_desc(), context);
   conv2_->release_scratch(arena);
   arena.release(conv1_->output());
@@ -48,7 +48,6 @@ void Refinement::begin(dnnl::stream& stream, const Tensor& context) {
   copy_channels(all_channels(context), constant_, 0);
   for (std::size_t p = 0; p < constant_.pixels(); ++p) constant_.data[p * constant_.c + kContextChannels] = kCorrRadiusPlane;
   conv1_constant_->run(stream, wrap_nhwc(constant_));
-  std::fill(hidden_.data.begin(), hidden_.data.end(), 0.f);
   for (std::size_t p = 0; p < input_.pixels(); ++p) {
     std::fill_n(input_.data.data() + p * input_.c + kHiddenOffset, kHiddenChannels, 0.f);
   }
@@ -69,16 +68,15 @@ void Refinement::step(dnnl::stream& stream, const ChannelSlice& f0, const Channe
 #pragma omp parallel for
   for (int p = 0; p < hw; ++p) {
     const float* o = output_.data.data() + static_cast<std::size_t>(p) * output_.c;
-    float* hid = hidden_.data.data() + static_cast<std::size_t>(p) * kHiddenChannels;
-    float* in_hid = input_.data.data() + static_cast<std::size_t>(p) * input_.c + kHiddenOffset;
-    for (int c = 0; c < kHiddenChannels; ++c) {
-      hid[c] = in_hid[c] = std::clamp(o[2 + c], -kHiddenClamp, kHiddenClamp);
-    }
-    delta_.data[2 * p] = o[0];
-    delta_.data[2 * p + 1] = o[1];
+    float* hidden = input_.data.data() + static_cast<std::size_t>(p) * input_.c + kHiddenOffset;
+    for (int c = 0; c < kHiddenChannels; ++c) hidden[c] = std::clamp(o[2 + c], -kHiddenClamp, kHiddenClamp);
     flow.data[2 * p] += o[0];
     flow.data[2 * p + 1] += o[1];
   }
 }
+
+Tensor Refinement::hidden() const { return extract_channels({&input_, kHiddenOffset, kHiddenChannels}); }
+
+Tensor Refinement::delta() const { return extract_channels({&output_, 0, 2}); }
 
 }  // namespace neuflow::model

@@ -26,14 +26,14 @@ class Refinement {
 
   // The input of the last step's first convolution: channels 0..80 are the correlation.
   const Tensor& last_input() const { return input_; }
-  const Tensor& hidden() const { return hidden_; }
-  const Tensor& delta() const { return delta_; }
+  // The last step's hidden state and flow update (copies, for an observer).
+  Tensor hidden() const;
+  Tensor delta() const;
 
  private:
   Tensor input_;     // [corr 81, hidden 64, flow 2]
   Tensor constant_;  // [context 64, radius plane]
   Tensor output_;    // conv3: [delta 2, hidden 64]
-  Tensor hidden_, delta_;
   std::optional<ConvOp> conv1_constant_, conv1_, conv2_, conv3_;
   std::array<std::optional<ConvOp>, 5> layers_;
 };

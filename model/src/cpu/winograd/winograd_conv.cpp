@@ -129,8 +129,7 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
       activation_(p.activation),
       accumulate_(p.accumulate),
       tiles_x_(divide_up(width, kOutputTile)),
-      tiles_(divide_up(height, kOutputTile) * tiles_x_),
-      arena_(&arena) {
+      tiles_(divide_up(height, kOutputTile) * tiles_x_) {
   if (!handles(w, p)) throw std::logic_error("WinogradConv: not a stride-1, pad-1 3x3 convolution");
 
   // Blocks of tiles: as many tiles as keep a block's inputs in L2, and a multiple of the
@@ -147,7 +146,8 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
   input_stride_ = point_stride_for(block_tiles_, in_channels_);
   product_stride_ = point_stride_for(block_tiles_, gemm_columns_);
   thread_floats_ = kPoints * (input_stride_ + product_stride_);
-  arena.reserve_workspace(sizeof(float) * thread_floats_ * static_cast<std::size_t>(threads_));
+  workspace_ = arena.make(dnnl::memory::desc({static_cast<dnnl::memory::dim>(thread_floats_) * threads_},
+                                             dnnl::memory::data_type::f32, dnnl::memory::format_tag::a));
 
   filters_ = shared_filters(w, *kernel_, in_channels_, gemm_columns_);
   bias_.assign(static_cast<std::size_t>(gemm_columns_), 0.f);
@@ -255,7 +255,7 @@ void WinogradConv::transform_outputs_as(const float* products, int first, int co
 
 void WinogradConv::run(const float* input, const float* addend, float* output) const {
   if (accumulate_ != (addend != nullptr)) throw std::logic_error("WinogradConv: addend given iff accumulate");
-  auto* workspace = reinterpret_cast<float*>(arena_->workspace());
+  auto* workspace = static_cast<float*>(workspace_.get_data_handle());
   const int threads = std::min(threads_, std::max(1, omp_get_max_threads()));
 #pragma omp parallel num_threads(threads)
   {

@@ -40,8 +40,13 @@ class WinogradConv {
   // True when these weights and parameters are a convolution this class computes.
   static bool handles(const ConvWeights& weights, const ConvParams& params);
 
+  // Its workspace (the transformed tiles of a block per thread) is a buffer of the arena's
+  // current region, alive until released.
   WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width,
                ChannelLayout input_layout, ChannelLayout output_layout, ScratchArena& arena);
+
+  // What run() uses only while it runs: release it once the convolution's output is made.
+  const dnnl::memory& workspace() const { return workspace_; }
 
   // input in input_layout; addend (iff params.accumulate) and output in output_layout, a
   // blocked output's padding channels written as zeros.
@@ -68,7 +73,7 @@ class WinogradConv {
   int threads_;
   std::size_t input_stride_, product_stride_;  // floats from one point to the next in a block
   std::size_t thread_floats_;                  // workspace floats each thread uses
-  const ScratchArena* arena_;
+  dnnl::memory workspace_;
   // [36][columns / panel][in_channels][panel], shared by every plan of the same model.
   std::shared_ptr<const std::vector<float>> filters_;
   std::vector<float> bias_;     // gemm_columns_ values
