@@ -1,6 +1,7 @@
 #include "winograd/winograd_conv.hpp"
 
 #include <omp.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -35,13 +36,24 @@ std::size_t point_stride_for(int tiles, int channels) {
 }
 int divide_up(int v, int m) { return (v + m - 1) / m; }
 
-// A block's tiles: one point's transformed inputs (tiles × channels) stay in the core's L2
-// (at least 512 KiB on the x86 cores we measure) while its product passes over them once per
-// panel of output channels, and a thread's whole workspace (36 points of inputs and
-// products) stays within a share of L3. Larger blocks read the filters fewer times.
-constexpr std::size_t kPointInputBytes = 256 * 1024;
-constexpr std::size_t kThreadWorkspaceBytes = 6 * 1024 * 1024;
+// A block's tiles: a thread's whole workspace (36 points of inputs and products) stays in
+// half of its core's L2, so what the input transform writes is still there when the products
+// read it, and what they write is still there for the output transform; the filters' panels
+// stream through the other half. Measured with neuflow-bench-conv on a 1 MiB-L2 core
+// (docs/benchmarks.md): a 6 MiB workspace (blocks of ~170 tiles, living in L3) made the
+// network's Winograd layers 2.3–2.5× the direct ones, a 512 KiB one 2.8–3.0×; smaller
+// blocks read the filters more often, but those reads stream from L2 and L3 at the
+// micro-kernel's pace. One point's inputs never exceed a quarter of the L2.
+constexpr std::size_t kFallbackL2Bytes = 1024 * 1024;  // where the C library cannot tell
 constexpr int kMaxBlockTiles = 480;
+
+std::size_t l2_bytes() {
+  static const std::size_t bytes = [] {
+    const long reported = sysconf(_SC_LEVEL2_CACHE_SIZE);  // 0 or -1 where unknown (e.g. some aarch64)
+    return reported >= 256 * 1024 ? static_cast<std::size_t>(reported) : kFallbackL2Bytes;
+  }();
+  return bytes;
+}
 
 template <Activation A>
 Float8 activate(Float8 v) {
@@ -132,12 +144,12 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
       tiles_(divide_up(height, kOutputTile) * tiles_x_) {
   if (!handles(w, p)) throw std::logic_error("WinogradConv: not a stride-1, pad-1 3x3 convolution");
 
-  // Blocks of tiles: as many tiles as keep a block's inputs in L2, and a multiple of the
+  // Blocks of tiles: as many tiles as keep a thread's workspace in half its L2, and a multiple of the
   // thread count of blocks so no thread waits for another's last block.
   threads_ = std::max(1, omp_get_max_threads());
-  const auto fit_point = static_cast<int>(kPointInputBytes / (sizeof(float) * in_channels_));
+  const auto fit_point = static_cast<int>(l2_bytes() / 4 / (sizeof(float) * in_channels_));
   const auto fit_thread =
-      static_cast<int>(kThreadWorkspaceBytes / (sizeof(float) * kPoints * (in_channels_ + gemm_columns_)));
+      static_cast<int>(l2_bytes() / 2 / (sizeof(float) * kPoints * (in_channels_ + gemm_columns_)));
   const int rows = kernel_->rows;
   const int most = std::clamp(std::min(fit_point, fit_thread) / rows * rows, rows, kMaxBlockTiles);
   blocks_ = round_up(divide_up(tiles_, most), threads_);
