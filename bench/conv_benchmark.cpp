@@ -1,8 +1,9 @@
 // Each stride-1 3×3 convolution of NeuFlow-V2 at its real shape for one model size, computed
-// by oneDNN's direct convolution and by Winograd F(4×4, 3×3), in the same run: the table from
-// which the CPU backend chooses per layer (model/src/cpu/dnnl/conv_op.cpp). Times are the
-// best of several runs; GFLOP/s counts the direct convolution's arithmetic for both, so
-// Winograd's figure can exceed the sgemm peak measured first.
+// by oneDNN's direct convolution and by Winograd F(4×4, 3×3) and F(6×6, 3×3), in the same
+// run: the table from which the CPU backend chooses per layer (model/src/cpu/dnnl/conv_op.cpp,
+// WinogradConv::faster_tile). Times are the best of several runs; GFLOP/s counts the direct
+// convolution's arithmetic for both, so Winograd's figure can exceed the sgemm peak measured
+// first.
 //
 // With --arena, instead: the CPU plan's transient-activation arena at that size, region by
 // region (one per stage; regions overlap, so the arena is the largest), in MB and bytes per
@@ -25,6 +26,7 @@
 #include "dnnl/context.hpp"
 #include "dnnl/conv_op.hpp"
 #include "network.hpp"
+#include "winograd/winograd_conv.hpp"
 #include "neuflow/model/architecture.hpp"
 #include "neuflow/model/flow_model.hpp"
 
@@ -122,8 +124,10 @@ int main(int argc, char** argv) {
   if (arena) return print_arena(model, width, height);
   const double peak = sgemm_peak_gflops(runs);
   std::printf("size %dx%d, threads %d, sgemm peak %.1f GFLOP/s\n", width, height, threads, peak);
-  std::printf("%-36s %5s %5s %9s %9s %9s %8s %8s %7s\n", "layer", "in", "out", "HxW", "direct_ms", "wino_ms",
-              "direct", "wino", "x_direct");
+  // f4_ms, f6_ms: Winograd F(4×4) and F(6×6) on the layer; tile: the form the plan picks
+  // (WinogradConv::faster_tile), which the wino GFLOP/s and x_direct columns describe.
+  std::printf("%-36s %5s %5s %9s %9s %8s %8s %4s %7s %7s %7s\n", "layer", "in", "out", "HxW", "direct_ms", "f4_ms",
+              "f6_ms", "tile", "direct", "wino", "x_direct");
   std::vector<Layer> layers;
   for (const auto& l : neuflow_v2_layers()) {
     if (l.kind == LayerKind::conv && l.kernel == 3) layers.push_back({l.name, l.in, l.out, l.scale});
@@ -138,12 +142,16 @@ int main(int argc, char** argv) {
     ConvWeights weights{l.out, l.in, 3, 3, std::vector<float>(static_cast<std::size_t>(l.out) * l.in * 9), {}};
     for (auto& v : weights.weight) v = u(rng);
     const double direct = time_conv(weights, h, w, CpuConvolution::direct, tag::nChw16c, runs);
-    const double wino = time_conv(weights, h, w, CpuConvolution::winograd, tag::nChw8c, runs);
+    const double wino4 = time_conv(weights, h, w, CpuConvolution::winograd4, tag::nChw8c, runs);
+    const double wino6 = time_conv(weights, h, w, CpuConvolution::winograd6, tag::nChw8c, runs);
+    const bool six = WinogradConv::faster_tile(l.in, l.out, h, w) == WinogradTile::f6x6;
+    const double wino = six ? wino6 : wino4;
     const double flops = 2.0 * h * w * l.in * l.out * 9;
     char hw[32];
     std::snprintf(hw, sizeof hw, "%dx%d", h, w);
-    std::printf("%-36s %5d %5d %9s %9.3f %9.3f %8.1f %8.1f %7.2f\n", l.name.c_str(), l.in, l.out, hw, direct * 1e3,
-                wino * 1e3, flops / direct / 1e9, flops / wino / 1e9, direct / wino);
+    std::printf("%-36s %5d %5d %9s %9.3f %8.3f %8.3f %4s %7.1f %7.1f %7.2f\n", l.name.c_str(), l.in, l.out, hw,
+                direct * 1e3, wino4 * 1e3, wino6 * 1e3, six ? "f6" : "f4", flops / direct / 1e9, flops / wino / 1e9,
+                direct / wino);
   }
   return 0;
 }

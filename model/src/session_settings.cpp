@@ -93,6 +93,8 @@ std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name) {
   if (name == "auto") return CpuConvolution::automatic;
   if (name == "direct") return CpuConvolution::direct;
   if (name == "winograd") return CpuConvolution::winograd;
+  if (name == "winograd4") return CpuConvolution::winograd4;
+  if (name == "winograd6") return CpuConvolution::winograd6;
   return std::nullopt;
 }
 
@@ -100,7 +102,7 @@ std::optional<CpuConvolution> cpu_convolution_from_environment() {
   const char* value = std::getenv("NEUFLOW_CONV");
   if (!value || !*value) return std::nullopt;
   if (const auto parsed = parse_cpu_convolution(value)) return parsed;
-  throw std::invalid_argument(std::string("NEUFLOW_CONV: expected auto, direct or winograd, got \"") + value + "\"");
+  throw std::invalid_argument(std::string("NEUFLOW_CONV: expected auto, direct, winograd, winograd4 or winograd6, got \"") + value + "\"");
 }
 
 }  // namespace neuflow::model

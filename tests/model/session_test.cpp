@@ -163,24 +163,29 @@ TEST_F(SessionTest, UnusableInputsAreRejectedWithAReason) {
   EXPECT_THROW(session.compute(bad, bad), std::invalid_argument);
 }
 
-// The CPU's two ways of computing the 3×3 convolutions give the same flow to rounding, the
-// environment's NEUFLOW_CONV choosing for sessions that leave it automatic, and a value that
-// is none of the three failing the session at creation with the variable's name.
+// The CPU's ways of computing the 3×3 convolutions (direct; Winograd with each layer's tile
+// form, or F(4×4) or F(6×6) everywhere) give the same flow to rounding, the environment's
+// NEUFLOW_CONV choosing for sessions that leave it automatic, and a value that is none of the
+// names failing the session at creation with the variable's name.
 TEST_F(SessionTest, DirectAndWinogradConvolutionsGiveTheSameFlow) {
   const auto flow_with = [&](CpuConvolution c) {
     FlowSession session(model_, {.threads = 2, .backend = Backend::cpu, .cpu_convolution = c});
     return session.compute(view_of(frames_[0]), view_of(frames_[1]));
   };
-  const auto direct = flow_with(CpuConvolution::direct), winograd = flow_with(CpuConvolution::winograd);
-  ASSERT_EQ(direct.uv.size(), winograd.uv.size());
-  double sum = 0, worst = 0;
-  for (std::size_t i = 0; i < direct.uv.size(); ++i) {
-    const double d = std::fabs(direct.uv[i] - winograd.uv[i]);
-    sum += d;
-    worst = std::max(worst, d);
+  const auto direct = flow_with(CpuConvolution::direct);
+  for (const CpuConvolution c : {CpuConvolution::winograd, CpuConvolution::winograd4, CpuConvolution::winograd6}) {
+    SCOPED_TRACE(std::string(cpu_convolution_name(c)));
+    const auto winograd = flow_with(c);
+    ASSERT_EQ(direct.uv.size(), winograd.uv.size());
+    double sum = 0, worst = 0;
+    for (std::size_t i = 0; i < direct.uv.size(); ++i) {
+      const double d = std::fabs(direct.uv[i] - winograd.uv[i]);
+      sum += d;
+      worst = std::max(worst, d);
+    }
+    EXPECT_LE(worst, 1e-2) << "px";
+    EXPECT_LE(sum / static_cast<double>(direct.uv.size()), 1e-3) << "px";
   }
-  EXPECT_LE(worst, 1e-2) << "px";
-  EXPECT_LE(sum / static_cast<double>(direct.uv.size()), 1e-3) << "px";
 
   struct Unset {
     ~Unset() { ::unsetenv("NEUFLOW_CONV"); }

@@ -23,12 +23,15 @@ enum class Backend { automatic, cpu, vulkan };
 enum class Precision { fp32, fp16 };
 
 // How the CPU backend computes its stride-1 3×3 convolutions, most of the network's
-// arithmetic: `automatic` by Winograd F(4×4, 3×3) on the layers where that measured faster
-// than oneDNN's direct convolution, unless the environment's NEUFLOW_CONV (auto, direct or
-// winograd) says otherwise; `direct` by oneDNN everywhere (the reference path for tests and
-// benchmarks); `winograd` on every such layer. Winograd's results differ from direct ones by
-// rounding only (tests/model/winograd_conv_test.cpp states the bound).
-enum class CpuConvolution { automatic, direct, winograd };
+// arithmetic: `automatic` by Winograd on the layers where that measured faster than oneDNN's
+// direct convolution, each layer with the tile form (F(4×4, 3×3) or F(6×6, 3×3)) that
+// measured faster at its size, unless the environment's NEUFLOW_CONV (auto, direct,
+// winograd, winograd4 or winograd6) says otherwise; `direct` by oneDNN everywhere (the
+// reference path for tests and benchmarks); `winograd` by Winograd on every such layer, tile
+// forms chosen as `automatic` does; `winograd4` and `winograd6` by one tile form everywhere,
+// to compare them. Winograd's results differ from direct ones by rounding only
+// (tests/model/winograd_conv_test.cpp states the bounds).
+enum class CpuConvolution { automatic, direct, winograd, winograd4, winograd6 };
 
 struct Iterations {
   int s16 = 1;  // refinement iterations at 1/16
@@ -101,12 +104,20 @@ constexpr std::string_view precision_name(Precision precision) { return precisio
 std::optional<Precision> parse_precision(std::string_view name);  // "fp32", "fp16"
 
 constexpr std::string_view cpu_convolution_name(CpuConvolution c) {
-  return c == CpuConvolution::direct ? "direct" : c == CpuConvolution::winograd ? "winograd" : "auto";
+  switch (c) {
+    case CpuConvolution::direct: return "direct";
+    case CpuConvolution::winograd: return "winograd";
+    case CpuConvolution::winograd4: return "winograd4";
+    case CpuConvolution::winograd6: return "winograd6";
+    case CpuConvolution::automatic: break;
+  }
+  return "auto";
 }
-std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name);  // "auto", "direct", "winograd"
+// "auto", "direct", "winograd", "winograd4", "winograd6"
+std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name);
 
 // What the environment's NEUFLOW_CONV asks for, when it is set and not empty; throws
-// std::invalid_argument naming the variable when its value is none of the three.
+// std::invalid_argument naming the variable when its value is none of those.
 std::optional<CpuConvolution> cpu_convolution_from_environment();
 
 }  // namespace neuflow::model

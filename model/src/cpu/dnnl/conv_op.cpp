@@ -57,7 +57,15 @@ bool use_winograd(const ConvWeights& w, const ConvParams& p, CpuConvolution choi
                   const std::optional<memory::desc>& output) {
   if (choice == CpuConvolution::direct || !WinogradConv::handles(w, p)) return false;
   if (output && !winograd_layout(*output)) return false;
-  return choice == CpuConvolution::winograd || w.in_channels >= kWinogradMinInputChannels;
+  return choice != CpuConvolution::automatic || w.in_channels >= kWinogradMinInputChannels;
+}
+
+// F(6×6, 3×3) where its share of the products is smaller, F(4×4, 3×3) where its tiles fit the
+// image with less overhang; both stay within the error bound of tests/model/winograd_conv_test.cpp.
+WinogradTile winograd_tile(CpuConvolution choice, const ConvWeights& w, int height, int width) {
+  if (choice == CpuConvolution::winograd4) return WinogradTile::f4x4;
+  if (choice == CpuConvolution::winograd6) return WinogradTile::f6x6;
+  return WinogradConv::faster_tile(w.in_channels, w.out_channels, height, width);
 }
 
 }  // namespace
@@ -94,7 +102,8 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
           dnnl::eltwise_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::eltwise_gelu_erf, out_desc),
           eng));
     }
-    winograd_.emplace(w, winograd_params, in_h, in_w, *winograd_layout(in_desc), *winograd_layout(out_desc), arena);
+    winograd_.emplace(w, winograd_params, in_h, in_w, *winograd_layout(in_desc), *winograd_layout(out_desc),
+                      winograd_tile(context.convolution, w, in_h, in_w), arena);
     dst_ = arena.make(out_desc);
     return;
   }

@@ -16,6 +16,8 @@
 
 #include "winograd/packed_gemm.hpp"
 #include "winograd/winograd_f43.hpp"
+#include "winograd/winograd_f63.hpp"
+#include "winograd/winograd_tile.hpp"
 
 namespace neuflow::model {
 
@@ -66,15 +68,16 @@ Float8 activate(Float8 v) {
 }
 
 // G g Gᵀ for every (output, input) pair of `w`, packed as `kernel` reads them.
+template <typename T>
 std::vector<float> transform_filters(const ConvWeights& w, const GemmKernel& kernel, int depth, int columns) {
   const int panel = kernel.panel;
   const int panels = columns / panel;
-  std::vector<float> filters(static_cast<std::size_t>(kPoints) * columns * depth, 0.f);
-  float points[kPoints];
+  std::vector<float> filters(static_cast<std::size_t>(T::kPoints) * columns * depth, 0.f);
+  float points[T::kPoints];
   for (int o = 0; o < w.out_channels; ++o) {
     for (int c = 0; c < w.in_channels; ++c) {
-      transform_filter(w.weight.data() + (static_cast<std::size_t>(o) * w.in_channels + c) * 9, points);
-      for (int xi = 0; xi < kPoints; ++xi) {
+      transform_filter<T>(w.weight.data() + (static_cast<std::size_t>(o) * w.in_channels + c) * 9, points);
+      for (int xi = 0; xi < T::kPoints; ++xi) {
         const std::size_t at = static_cast<std::size_t>(xi) * panels + o / panel;
         filters[(at * depth + c) * panel + o % panel] = points[xi];
       }
@@ -96,21 +99,66 @@ std::uint64_t fingerprint(const ConvWeights& w) {
 // every session of a model shares them, the way sessions share the model: one copy per
 // layer for as long as a plan uses it.
 std::shared_ptr<const std::vector<float>> shared_filters(const ConvWeights& w, const GemmKernel& kernel, int depth,
-                                                         int columns) {
-  using Key = std::tuple<const float*, std::size_t, std::uint64_t, const GemmKernel*>;
+                                                         int columns, WinogradTile tile) {
+  using Key = std::tuple<const float*, std::size_t, std::uint64_t, const GemmKernel*, WinogradTile>;
   static std::mutex mutex;
   static std::map<Key, std::weak_ptr<const std::vector<float>>> cache;
-  const Key key{w.weight.data(), w.weight.size(), fingerprint(w), &kernel};
+  const Key key{w.weight.data(), w.weight.size(), fingerprint(w), &kernel, tile};
   const std::lock_guard lock(mutex);
   std::erase_if(cache, [](const auto& e) { return e.second.expired(); });  // layers no plan uses
   auto& entry = cache[key];
   if (auto filters = entry.lock()) return filters;
-  auto filters = std::make_shared<const std::vector<float>>(transform_filters(w, kernel, depth, columns));
+  auto filters = std::make_shared<const std::vector<float>>(
+      tile == WinogradTile::f6x6 ? transform_filters<F63>(w, kernel, depth, columns)
+                                 : transform_filters<F43>(w, kernel, depth, columns));
   entry = filters;
   return filters;
 }
 
+int output_tile_of(WinogradTile tile) { return tile == WinogradTile::f6x6 ? F63::kOutputTile : F43::kOutputTile; }
+int points_of(WinogradTile tile) { return tile == WinogradTile::f6x6 ? F63::kPoints : F43::kPoints; }
+
+// How a layer's tiles are split into blocks.
+struct Blocking {
+  int tiles_x, tiles;
+  int block_tiles;  // a multiple of the kernel's rows
+  int blocks;
+};
+
+// Blocks of tiles: as many tiles as keep a thread's workspace in half its L2, and a multiple of
+// the thread count of blocks so no thread waits for another's last block. Channels padded as
+// the products read them (inputs to 8, outputs to the kernel's panel).
+Blocking blocking_for(WinogradTile tile, int in_channels, int gemm_columns, int height, int width, int rows,
+                      int threads) {
+  Blocking b{};
+  b.tiles_x = divide_up(width, output_tile_of(tile));
+  b.tiles = divide_up(height, output_tile_of(tile)) * b.tiles_x;
+  const auto fit_point = static_cast<int>(l2_bytes() / 4 / (sizeof(float) * in_channels));
+  const auto fit_thread =
+      static_cast<int>(l2_bytes() / 2 / (sizeof(float) * points_of(tile) * (in_channels + gemm_columns)));
+  const int most = std::clamp(std::min(fit_point, fit_thread) / rows * rows, rows, kMaxBlockTiles);
+  b.blocks = round_up(divide_up(b.tiles, most), threads);
+  b.block_tiles = round_up(divide_up(b.tiles, b.blocks), rows);
+  b.blocks = divide_up(b.tiles, b.block_tiles);
+  return b;
+}
+
 }  // namespace
+
+long WinogradConv::busiest_thread_products(WinogradTile tile, int in_channels, int out_channels, int height,
+                                           int width) {
+  const GemmKernel& kernel = gemm_kernel();
+  const int threads = std::max(1, omp_get_max_threads());
+  const Blocking b = blocking_for(tile, round_up(in_channels, kLanes), round_up(out_channels, kernel.panel), height,
+                                  width, kernel.rows, threads);
+  return static_cast<long>(divide_up(b.blocks, threads)) * b.block_tiles * points_of(tile);
+}
+
+WinogradTile WinogradConv::faster_tile(int in_channels, int out_channels, int height, int width) {
+  const long f6 = busiest_thread_products(WinogradTile::f6x6, in_channels, out_channels, height, width);
+  const long f4 = busiest_thread_products(WinogradTile::f4x4, in_channels, out_channels, height, width);
+  return f6 < f4 ? WinogradTile::f6x6 : WinogradTile::f4x4;
+}
 
 ChannelPlacement::ChannelPlacement(ChannelLayout layout, int c, int height, int w) : channels(c), width(w) {
   const int lanes = layout == ChannelLayout::blocked16 ? 16 : 8;
@@ -129,8 +177,12 @@ bool WinogradConv::handles(const ConvWeights& w, const ConvParams& p) {
 }
 
 WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height, int width,
-                           ChannelLayout input_layout, ChannelLayout output_layout, ScratchArena& arena)
-    : height_(height),
+                           ChannelLayout input_layout, ChannelLayout output_layout, WinogradTile tile,
+                           ScratchArena& arena)
+    : tile_(tile),
+      output_tile_(output_tile_of(tile)),
+      points_(points_of(tile)),
+      height_(height),
       width_(width),
       input_(input_layout, w.in_channels, height, width),
       output_(output_layout, w.out_channels, height, width),
@@ -139,34 +191,28 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
       kernel_(&gemm_kernel()),
       gemm_columns_(round_up(w.out_channels, kernel_->panel)),
       activation_(p.activation),
-      accumulate_(p.accumulate),
-      tiles_x_(divide_up(width, kOutputTile)),
-      tiles_(divide_up(height, kOutputTile) * tiles_x_) {
+      accumulate_(p.accumulate) {
   if (!handles(w, p)) throw std::logic_error("WinogradConv: not a stride-1, pad-1 3x3 convolution");
-
-  // Blocks of tiles: as many tiles as keep a thread's workspace in half its L2, and a multiple of the
-  // thread count of blocks so no thread waits for another's last block.
   threads_ = std::max(1, omp_get_max_threads());
-  const auto fit_point = static_cast<int>(l2_bytes() / 4 / (sizeof(float) * in_channels_));
-  const auto fit_thread =
-      static_cast<int>(l2_bytes() / 2 / (sizeof(float) * kPoints * (in_channels_ + gemm_columns_)));
-  const int rows = kernel_->rows;
-  const int most = std::clamp(std::min(fit_point, fit_thread) / rows * rows, rows, kMaxBlockTiles);
-  blocks_ = round_up(divide_up(tiles_, most), threads_);
-  block_tiles_ = round_up(divide_up(tiles_, blocks_), rows);
-  blocks_ = divide_up(tiles_, block_tiles_);
+  const Blocking b = blocking_for(tile, in_channels_, gemm_columns_, height, width, kernel_->rows, threads_);
+  tiles_x_ = b.tiles_x;
+  tiles_ = b.tiles;
+  block_tiles_ = b.block_tiles;
+  blocks_ = b.blocks;
   input_stride_ = point_stride_for(block_tiles_, in_channels_);
   product_stride_ = point_stride_for(block_tiles_, gemm_columns_);
-  thread_floats_ = kPoints * (input_stride_ + product_stride_);
+  thread_floats_ = points_ * (input_stride_ + product_stride_);
   workspace_ = arena.make(dnnl::memory::desc({static_cast<dnnl::memory::dim>(thread_floats_) * threads_},
                                              dnnl::memory::data_type::f32, dnnl::memory::format_tag::a));
 
-  filters_ = shared_filters(w, *kernel_, in_channels_, gemm_columns_);
+  filters_ = shared_filters(w, *kernel_, in_channels_, gemm_columns_, tile_);
   bias_.assign(static_cast<std::size_t>(gemm_columns_), 0.f);
   std::copy(w.bias.begin(), w.bias.end(), bias_.begin());
 }
 
+template <typename T>
 void WinogradConv::transform_inputs(const float* input, int first, int count, float* points) const {
+  constexpr int kInputTile = T::kInputTile, kOutputTile = T::kOutputTile, kPoints = T::kPoints;
   const std::size_t point_stride = input_stride_;
   const int groups = in_channels_ / kLanes;
   const std::size_t row = static_cast<std::size_t>(width_) * input_.pixel;
@@ -201,7 +247,7 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
           }
         }
       }
-      transform_input(d, v);
+      transform_input<T>(d, v);
       float* dst = points + static_cast<std::size_t>(t) * in_channels_ + g * kLanes;
       for (int xi = 0; xi < kPoints; ++xi) store8(dst + xi * point_stride, v[xi]);
     }
@@ -214,20 +260,22 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
   }
 }
 
+template <typename T>
 void WinogradConv::transform_outputs(const float* products, int first, int count, const float* addend,
                                      float* output) const {
   switch (activation_) {
-    case Activation::none: return transform_outputs_as<Activation::none>(products, first, count, addend, output);
+    case Activation::none: return transform_outputs_as<T, Activation::none>(products, first, count, addend, output);
     case Activation::leaky_relu:
-      return transform_outputs_as<Activation::leaky_relu>(products, first, count, addend, output);
-    case Activation::relu: return transform_outputs_as<Activation::relu>(products, first, count, addend, output);
-    case Activation::gelu: return transform_outputs_as<Activation::gelu>(products, first, count, addend, output);
+      return transform_outputs_as<T, Activation::leaky_relu>(products, first, count, addend, output);
+    case Activation::relu: return transform_outputs_as<T, Activation::relu>(products, first, count, addend, output);
+    case Activation::gelu: return transform_outputs_as<T, Activation::gelu>(products, first, count, addend, output);
   }
 }
 
-template <Activation A>
+template <typename T, Activation A>
 void WinogradConv::transform_outputs_as(const float* products, int first, int count, const float* addend,
                                         float* output) const {
+  constexpr int kOutputTile = T::kOutputTile, kPoints = T::kPoints;
   const std::size_t point_stride = product_stride_;
   const int groups = out_channels_ / kLanes;
   const std::size_t row = static_cast<std::size_t>(width_) * output_.pixel;
@@ -241,7 +289,7 @@ void WinogradConv::transform_outputs_as(const float* products, int first, int co
     for (int g = 0; g < groups; ++g) {
       const float* src = products + static_cast<std::size_t>(t) * gemm_columns_ + g * kLanes;
       for (int xi = 0; xi < kPoints; ++xi) m[xi] = load8(src + xi * point_stride);
-      transform_output(m, o);
+      transform_output<T>(m, o);
       const Float8 bias = load8(bias_.data() + g * kLanes);
       // In NHWC the last group may hold fewer than eight channels: only those are written.
       const int lanes = output_.partial_last_group && g == groups - 1 ? output_.channels - g * kLanes : kLanes;
@@ -267,6 +315,16 @@ void WinogradConv::transform_outputs_as(const float* products, int first, int co
 
 void WinogradConv::run(const float* input, const float* addend, float* output) const {
   if (accumulate_ != (addend != nullptr)) throw std::logic_error("WinogradConv: addend given iff accumulate");
+  if (tile_ == WinogradTile::f6x6) {
+    run_as<F63>(input, addend, output);
+  } else {
+    run_as<F43>(input, addend, output);
+  }
+}
+
+template <typename T>
+void WinogradConv::run_as(const float* input, const float* addend, float* output) const {
+  constexpr int kPoints = T::kPoints;
   auto* workspace = static_cast<float*>(workspace_.get_data_handle());
   const int threads = std::min(threads_, std::max(1, omp_get_max_threads()));
 #pragma omp parallel num_threads(threads)
@@ -278,13 +336,13 @@ void WinogradConv::run(const float* input, const float* addend, float* output) c
       const int first = b * block_tiles_;
       const int count = std::min(block_tiles_, tiles_ - first);
       const int rows = round_up(count, kernel_->rows);
-      transform_inputs(input, first, count, points);
+      transform_inputs<T>(input, first, count, points);
       for (int xi = 0; xi < kPoints; ++xi) {
         kernel_->run(points + xi * input_stride_,
                     filters_->data() + static_cast<std::size_t>(xi) * gemm_columns_ * in_channels_,
                      products + xi * product_stride_, rows, in_channels_, gemm_columns_);
       }
-      transform_outputs(products, first, count, addend, output);
+      transform_outputs<T>(products, first, count, addend, output);
     }
   }
 }

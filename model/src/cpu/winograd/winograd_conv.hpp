@@ -1,11 +1,11 @@
 #pragma once
-// A stride-1, pad-1 3×3 convolution by Winograd F(4×4, 3×3) for one input size, reading and
-// writing the layouts its neighbours use (NHWC, oneDNN's nChw8c or nChw16c), so no reorder
-// sits between it and them. The filters are transformed once here. run() splits
-// the output's 4×4 tiles into blocks, one thread a block: each block's inputs are transformed
-// (Bᵀ d B), multiplied by the filters point by point (36 products of tiles × channels), and
-// transformed back (Aᵀ m A) with bias, addend and activation applied on the way out, so a
-// block's intermediate data stays in the core's cache.
+// A stride-1, pad-1 3×3 convolution by Winograd F(4×4, 3×3) or F(6×6, 3×3) for one input
+// size, reading and writing the layouts its neighbours use (NHWC, oneDNN's nChw8c or
+// nChw16c), so no reorder sits between it and them. The filters are transformed once here.
+// run() splits the output's tiles into blocks, one thread a block: each block's inputs are
+// transformed (Bᵀ d B), multiplied by the filters point by point (36 or 64 products of
+// tiles × channels), and transformed back (Aᵀ m A) with bias, addend and activation applied
+// on the way out, so a block's intermediate data stays in the core's cache.
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -35,6 +35,9 @@ struct ChannelPlacement {
   bool partial_last_group;  // NHWC with channels not a multiple of 8: the last 8 are partial
 };
 
+// The output tile: F(4×4, 3×3) or F(6×6, 3×3) (fewer products, more rounding error).
+enum class WinogradTile { f4x4, f6x6 };
+
 class WinogradConv {
  public:
   // True when these weights and parameters are a convolution this class computes.
@@ -43,7 +46,16 @@ class WinogradConv {
   // Its workspace (the transformed tiles of a block per thread) is a buffer of the arena's
   // current region, alive until released.
   WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width,
-               ChannelLayout input_layout, ChannelLayout output_layout, ScratchArena& arena);
+               ChannelLayout input_layout, ChannelLayout output_layout, WinogradTile tile, ScratchArena& arena);
+
+  WinogradTile tile() const { return tile_; }
+
+  // The products (tile rows × points) the busiest of omp_get_max_threads() threads computes
+  // for a layer of this shape with this tile form: its share of the arithmetic, counting the
+  // tiles that overhang the image and the blocks' rounding. faster_tile() picks the form with
+  // the smaller share; neuflow-bench-conv times both at every layer to check the choice.
+  static long busiest_thread_products(WinogradTile tile, int in_channels, int out_channels, int height, int width);
+  static WinogradTile faster_tile(int in_channels, int out_channels, int height, int width);
 
   // What run() uses only while it runs: release it once the convolution's output is made.
   const dnnl::memory& workspace() const { return workspace_; }
@@ -53,12 +65,18 @@ class WinogradConv {
   void run(const float* input, const float* addend, float* output) const;
 
  private:
+  template <typename T>
+  void run_as(const float* input, const float* addend, float* output) const;
+  template <typename T>
   void transform_inputs(const float* input, int first_tile, int count, float* points) const;
+  template <typename T>
   void transform_outputs(const float* products, int first_tile, int count, const float* addend, float* output) const;
-  template <Activation A>
+  template <typename T, Activation A>
   void transform_outputs_as(const float* products, int first_tile, int count, const float* addend,
                             float* output) const;
 
+  WinogradTile tile_;
+  int output_tile_, points_;  // the tile form's output side and points per tile
   int height_, width_;
   ChannelPlacement input_, output_;
   int in_channels_;      // padded to 8
@@ -74,7 +92,7 @@ class WinogradConv {
   std::size_t input_stride_, product_stride_;  // floats from one point to the next in a block
   std::size_t thread_floats_;                  // workspace floats each thread uses
   dnnl::memory workspace_;
-  // [36][columns / panel][in_channels][panel], shared by every plan of the same model.
+  // [points][columns / panel][in_channels][panel], shared by every plan of the same model.
   std::shared_ptr<const std::vector<float>> filters_;
   std::vector<float> bias_;     // gemm_columns_ values
 };
