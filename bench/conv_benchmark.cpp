@@ -56,14 +56,15 @@ double sgemm_peak_gflops(int runs) {
 
 struct Layer {
   std::string name;
-  int in, out, scale;
+  int in, out, scale;  // scale: the output's
+  int stride = 1;      // kernel 3·stride, padding stride
 };
 
-// Times one layer's convolution computed as `choice` says, its input in `layout`.
-double time_conv(const ConvWeights& w, int h, int width, CpuConvolution choice, tag layout, int runs) {
+// Times one layer's convolution computed as `choice` says, its input (h × width) in `layout`.
+double time_conv(const ConvWeights& w, int stride, int h, int width, CpuConvolution choice, tag layout, int runs) {
   PlanContext context{{}, choice};
   const dnnl::memory::desc in_desc({1, w.in_channels, h, width}, dnnl::memory::data_type::f32, layout);
-  ConvOp op(w, {1, 1, Activation::leaky_relu}, in_desc, context);
+  ConvOp op(w, {stride, stride, Activation::leaky_relu}, in_desc, context);
   dnnl::memory input = context.arena.make(in_desc);
   context.arena.finalize();
   std::memset(input.get_data_handle(), 0, in_desc.get_size());
@@ -131,6 +132,8 @@ int main(int argc, char** argv) {
   std::vector<Layer> layers;
   for (const auto& l : neuflow_v2_layers()) {
     if (l.kind == LayerKind::conv && l.kernel == 3) layers.push_back({l.name, l.in, l.out, l.scale});
+    // The backbone's 6×6 stride-2 convolution on 192 channels, by space-to-depth.
+    if (l.kind == LayerKind::conv && l.kernel == 6 && l.in % 8 == 0) layers.push_back({l.name, l.in, l.out, l.scale, 2});
   }
   // The refinements' first convolution runs as two: the per-iteration inputs and the per-pair constant ones.
   layers.push_back({"refine_s8.conv1 (per iteration)", 147, 128, 8});
@@ -139,14 +142,15 @@ int main(int argc, char** argv) {
   std::uniform_real_distribution<float> u(-0.05f, 0.05f);
   for (const auto& l : layers) {
     const int h = height / l.scale, w = width / l.scale;
-    ConvWeights weights{l.out, l.in, 3, 3, std::vector<float>(static_cast<std::size_t>(l.out) * l.in * 9), {}};
+    const int k = 3 * l.stride, ih = h * l.stride, iw = w * l.stride;
+    ConvWeights weights{l.out, l.in, k, k, std::vector<float>(static_cast<std::size_t>(l.out) * l.in * k * k), {}};
     for (auto& v : weights.weight) v = u(rng);
-    const double direct = time_conv(weights, h, w, CpuConvolution::direct, tag::nChw16c, runs);
-    const double wino4 = time_conv(weights, h, w, CpuConvolution::winograd4, tag::nChw8c, runs);
-    const double wino6 = time_conv(weights, h, w, CpuConvolution::winograd6, tag::nChw8c, runs);
-    const bool six = WinogradConv::faster_tile(l.in, l.out, h, w) == WinogradTile::f6x6;
+    const double direct = time_conv(weights, l.stride, ih, iw, CpuConvolution::direct, tag::nChw16c, runs);
+    const double wino4 = time_conv(weights, l.stride, ih, iw, CpuConvolution::winograd4, tag::nChw8c, runs);
+    const double wino6 = time_conv(weights, l.stride, ih, iw, CpuConvolution::winograd6, tag::nChw8c, runs);
+    const bool six = WinogradConv::faster_tile(l.in * l.stride * l.stride, l.out, h, w) == WinogradTile::f6x6;
     const double wino = six ? wino6 : wino4;
-    const double flops = 2.0 * h * w * l.in * l.out * 9;
+    const double flops = 2.0 * h * w * l.in * l.out * k * k;
     char hw[32];
     std::snprintf(hw, sizeof hw, "%dx%d", h, w);
     std::printf("%-36s %5d %5d %9s %9.3f %8.3f %8.3f %4s %7.1f %7.1f %7.2f\n", l.name.c_str(), l.in, l.out, hw,

@@ -84,8 +84,8 @@ struct ConvCase {
 
 class ConvOpTest : public ::testing::TestWithParam<std::tuple<ConvCase, CpuConvolution>> {};
 
-// Both ways of computing a convolution: oneDNN's direct one and (for stride-1 3×3 layers)
-// Winograd F(4×4, 3×3); each against the definition in double.
+// Each way of computing a convolution: oneDNN's direct one and (for the layers it takes)
+// Winograd F(4×4, 3×3) or F(6×6, 3×3); each against the definition in double.
 TEST_P(ConvOpTest, MatchesNaiveConvolution) {
   const ConvCase p = std::get<0>(GetParam());
   const CpuConvolution algorithm = std::get<1>(GetParam());
@@ -102,7 +102,11 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
   PlanContext context{{}, algorithm};
   ConvOp op(w, {p.stride, p.pad, p.act, p.accumulate}, nhwc_desc(p.h, p.w, p.in_c), context);
   context.arena.finalize();
-  ASSERT_EQ(op.is_winograd(), algorithm == CpuConvolution::winograd && p.k == 3 && p.stride == 1);
+  // Winograd takes stride-1 3×3 layers, and 3s-wide stride-s ones with padding s on a
+  // multiple of 8 channels and an input of whole phases (by space-to-depth).
+  const bool winograd_shape = p.k == 3 * p.stride && p.pad == p.stride &&
+                              (p.stride == 1 || (p.in_c % 8 == 0 && p.h % p.stride == 0 && p.w % p.stride == 0));
+  ASSERT_EQ(op.is_winograd(), algorithm != CpuConvolution::direct && winograd_shape);
   std::optional<dnnl::memory> addend;
   if (p.accumulate) {
     addend_t.resize(op.out_h(), op.out_w(), p.out_c);
@@ -143,8 +147,13 @@ INSTANTIATE_TEST_SUITE_P(NetworkShapes, ConvOpTest,
                                            ConvCase{64, 40, 1, 1, 0, 4, 4, true, Activation::none, false},
                                            ConvCase{40, 24, 3, 1, 1, 5, 5, false, Activation::gelu, false},
                                            // Several tiles, borders cut inside a tile, channels past one block.
-                                           ConvCase{20, 36, 3, 1, 1, 13, 18, true, Activation::leaky_relu, true}),
-                                           ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd)));
+                                           ConvCase{20, 36, 3, 1, 1, 13, 18, true, Activation::leaky_relu, true},
+                                           // 6×6 stride 2 (block_8_16): by space-to-depth on 16 channels,
+                                           // and on an odd-sized input, directly.
+                                           ConvCase{16, 24, 6, 2, 2, 14, 18, true, Activation::leaky_relu, false},
+                                           ConvCase{16, 24, 6, 2, 2, 13, 18, true, Activation::leaky_relu, false}),
+                                           ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd4,
+                                                             CpuConvolution::winograd6)));
 
 // The arena reuses a released buffer's bytes for buffers made afterwards in the same region,
 // never lets two buffers alive at the same time overlap, and places the largest first: here a

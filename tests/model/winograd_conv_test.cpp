@@ -1,7 +1,8 @@
-// Winograd F(4×4, 3×3) and F(6×6, 3×3) against oneDNN's direct convolution at every stride-1
-// 3×3 layer of NeuFlow-V2, at the shapes a 768×432 and a 1024×448 model size give them (1/16
-// is 27 rows and 1/8 is 56 rows: tiles cut by the border), on random data; and each product
-// kernel this CPU runs against the portable one.
+// Winograd F(4×4, 3×3) and F(6×6, 3×3) against oneDNN's direct convolution at every layer of
+// NeuFlow-V2 it computes (the stride-1 3×3 ones, and the 6×6 stride-2 one by space-to-depth),
+// at the shapes a 768×432 and a 1024×448 model size give them (1/16 is 27 rows and 1/8 is 56
+// rows: tiles cut by the border), on random data; and each product kernel this CPU runs
+// against the portable one.
 //
 // The bound: the largest difference from the direct result is at most 1e-5 (F(4×4)) or 2e-5
 // (F(6×6), whose transform coefficients reach 32) of the sum of |weight × input| over the
@@ -29,13 +30,17 @@ using tag = dnnl::memory::format_tag;
 
 struct LayerShape {
   std::string name;
-  int in, out, scale;
+  int in, out, scale;  // scale: the output's
+  int stride = 1;      // kernel 3·stride, padding stride
 };
 
-std::vector<LayerShape> stride1_3x3_layers() {
+// Every layer Winograd computes: the stride-1 3×3 ones and the 6×6 stride-2 one on 192
+// channels (block_8_16.conv1, by space-to-depth).
+std::vector<LayerShape> winograd_layers() {
   std::vector<LayerShape> layers;
   for (const auto& l : neuflow_v2_layers()) {
     if (l.kind == LayerKind::conv && l.kernel == 3) layers.push_back({l.name, l.in, l.out, l.scale});
+    if (l.kind == LayerKind::conv && l.kernel == 6 && l.in % 8 == 0) layers.push_back({l.name, l.in, l.out, l.scale, 2});
   }
   // The refinements' first convolution runs split: per-iteration inputs and per-pair constants.
   for (const int scale : {8, 16}) {
@@ -48,7 +53,8 @@ std::vector<LayerShape> stride1_3x3_layers() {
 // Runs one convolution on an NHWC input and returns its NHWC output.
 Tensor convolve(const ConvWeights& w, const Tensor& input, CpuConvolution choice, bool& used_winograd) {
   PlanContext context{{}, choice};
-  ConvOp op(w, {1, 1, Activation::none}, nhwc_desc(input.h, input.w, input.c), context);
+  const int stride = w.kernel_h / 3;
+  ConvOp op(w, {stride, stride, Activation::none}, nhwc_desc(input.h, input.w, input.c), context);
   context.arena.finalize();
   used_winograd = op.is_winograd();
   dnnl::stream stream(cpu_engine());
@@ -65,12 +71,13 @@ TEST_P(WinogradTileForm, MatchesDirectAtEveryNetworkLayer) {
   std::mt19937 rng(7);
   std::normal_distribution<float> normal(0.f, 1.f);
   for (const auto& [width, height] : {std::pair{768, 432}, std::pair{1024, 448}}) {
-    for (const auto& layer : stride1_3x3_layers()) {
+    for (const auto& layer : winograd_layers()) {
       SCOPED_TRACE(layer.name + " at " + std::to_string(width) + "x" + std::to_string(height));
-      const int h = height / layer.scale, w = width / layer.scale;
-      ConvWeights weights{layer.out, layer.in, 3, 3, std::vector<float>(static_cast<std::size_t>(layer.out) * layer.in * 9),
+      const int h = height / layer.scale * layer.stride, w = width / layer.scale * layer.stride;  // the input's
+      const int k = 3 * layer.stride;
+      ConvWeights weights{layer.out, layer.in, k, k, std::vector<float>(static_cast<std::size_t>(layer.out) * layer.in * k * k),
                           std::vector<float>(static_cast<std::size_t>(layer.out))};
-      const float scale = 1.f / std::sqrt(9.f * layer.in);
+      const float scale = 1.f / std::sqrt(static_cast<float>(k * k * layer.in));
       for (auto& v : weights.weight) v = scale * normal(rng);
       for (auto& v : weights.bias) v = 0.1f * normal(rng);
       Tensor input(h, w, layer.in);

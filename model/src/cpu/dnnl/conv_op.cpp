@@ -28,9 +28,9 @@ dnnl::primitive_attr make_attr(const ConvParams& p) {
   return attr;
 }
 
-// Where Winograd F(4×4, 3×3) measured faster than oneDNN's direct convolution
-// (docs/benchmarks.md, "Winograd", neuflow-bench-conv): every stride-1 3×3 layer of the
-// network with at least this many input channels.
+// Where Winograd measured faster than oneDNN's direct convolution (docs/benchmarks.md,
+// "Winograd", neuflow-bench-conv): every layer it computes (stride-1 3×3, and the 6×6
+// stride-2 one by space-to-depth) with at least this many input channels.
 constexpr int kWinogradMinInputChannels = 32;
 
 // The layout of `d` if Winograd reads and writes it in place.
@@ -53,19 +53,20 @@ memory::format_tag preferred_blocking() {
   return tag::nChw8c;
 }
 
-bool use_winograd(const ConvWeights& w, const ConvParams& p, CpuConvolution choice,
+bool use_winograd(const ConvWeights& w, const ConvParams& p, int height, int width, CpuConvolution choice,
                   const std::optional<memory::desc>& output) {
-  if (choice == CpuConvolution::direct || !WinogradConv::handles(w, p)) return false;
+  if (choice == CpuConvolution::direct || !WinogradConv::handles(w, p, height, width)) return false;
   if (output && !winograd_layout(*output)) return false;
   return choice != CpuConvolution::automatic || w.in_channels >= kWinogradMinInputChannels;
 }
 
 // F(6×6, 3×3) where its share of the products is smaller, F(4×4, 3×3) where its tiles fit the
 // image with less overhang; both stay within the error bound of tests/model/winograd_conv_test.cpp.
-WinogradTile winograd_tile(CpuConvolution choice, const ConvWeights& w, int height, int width) {
+// (height, width: the output's; a strided layer's products have s² times its input channels.)
+WinogradTile winograd_tile(CpuConvolution choice, const ConvWeights& w, int stride, int height, int width) {
   if (choice == CpuConvolution::winograd4) return WinogradTile::f4x4;
   if (choice == CpuConvolution::winograd6) return WinogradTile::f6x6;
-  return WinogradConv::faster_tile(w.in_channels, w.out_channels, height, width);
+  return WinogradConv::faster_tile(w.in_channels * stride * stride, w.out_channels, height, width);
 }
 
 }  // namespace
@@ -85,7 +86,7 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
   out_h_ = (in_h + 2 * p.pad - w.kernel_h) / p.stride + 1;
   out_w_ = (in_w + 2 * p.pad - w.kernel_w) / p.stride + 1;
 
-  if (use_winograd(w, p, context.convolution, output)) {
+  if (use_winograd(w, p, in_h, in_w, context.convolution, output)) {
     const memory::desc out_desc = output ? *output : memory::desc({1, out_c_, out_h_, out_w_}, dt::f32, preferred_blocking());
     memory::desc in_desc = input;
     if (!winograd_layout(input)) {  // not one it reads in place
@@ -103,7 +104,7 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
           eng));
     }
     winograd_.emplace(w, winograd_params, in_h, in_w, *winograd_layout(in_desc), *winograd_layout(out_desc),
-                      winograd_tile(context.convolution, w, in_h, in_w), arena);
+                      winograd_tile(context.convolution, w, p.stride, out_h_, out_w_), arena);
     dst_ = arena.make(out_desc);
     return;
   }

@@ -86,6 +86,29 @@ std::vector<float> transform_filters(const ConvWeights& w, const GemmKernel& ker
   return filters;
 }
 
+// A stride-s convolution whose kernel is 3s wide with padding s is, on the space-to-depth view
+// of its input (s² phases × C channels at 1/s the size), a stride-1, pad-1 3×3 one: output
+// o reads input rows s·o − s … s·o + 2s − 1, i.e. phase rows o − 1, o, o + 1. Its 3×3 filter
+// for (out, phase (ry, rx), channel c) is taps (s·ky + ry, s·kx + rx) of the original; view
+// channel (ry·s + rx)·C + c.
+ConvWeights space_to_depth_filters(const ConvWeights& w, int s) {
+  if (s == 1) return w;
+  const int c_in = w.in_channels, k = w.kernel_h, depth = c_in * s * s;
+  ConvWeights r{w.out_channels, depth, 3, 3, std::vector<float>(static_cast<std::size_t>(w.out_channels) * depth * 9), w.bias};
+  for (int o = 0; o < w.out_channels; ++o) {
+    for (int phase = 0; phase < s * s; ++phase) {
+      for (int c = 0; c < c_in; ++c) {
+        float* dst = r.weight.data() + (static_cast<std::size_t>(o) * depth + phase * c_in + c) * 9;
+        const float* src = w.weight.data() + (static_cast<std::size_t>(o) * c_in + c) * k * k;
+        for (int ky = 0; ky < 3; ++ky) {
+          for (int kx = 0; kx < 3; ++kx) dst[ky * 3 + kx] = src[(s * ky + phase / s) * k + s * kx + phase % s];
+        }
+      }
+    }
+  }
+  return r;
+}
+
 // FNV-1a over the weights' bytes: with the address, what identifies a layer's weights even if
 // another layer's were once at that address.
 std::uint64_t fingerprint(const ConvWeights& w) {
@@ -99,18 +122,19 @@ std::uint64_t fingerprint(const ConvWeights& w) {
 // every session of a model shares them, the way sessions share the model: one copy per
 // layer for as long as a plan uses it.
 std::shared_ptr<const std::vector<float>> shared_filters(const ConvWeights& w, const GemmKernel& kernel, int depth,
-                                                         int columns, WinogradTile tile) {
-  using Key = std::tuple<const float*, std::size_t, std::uint64_t, const GemmKernel*, WinogradTile>;
+                                                         int columns, WinogradTile tile, int stride) {
+  using Key = std::tuple<const float*, std::size_t, std::uint64_t, const GemmKernel*, WinogradTile, int>;
   static std::mutex mutex;
   static std::map<Key, std::weak_ptr<const std::vector<float>>> cache;
-  const Key key{w.weight.data(), w.weight.size(), fingerprint(w), &kernel, tile};
+  const Key key{w.weight.data(), w.weight.size(), fingerprint(w), &kernel, tile, stride};
   const std::lock_guard lock(mutex);
   std::erase_if(cache, [](const auto& e) { return e.second.expired(); });  // layers no plan uses
   auto& entry = cache[key];
   if (auto filters = entry.lock()) return filters;
+  const ConvWeights w3 = space_to_depth_filters(w, stride);
   auto filters = std::make_shared<const std::vector<float>>(
-      tile == WinogradTile::f6x6 ? transform_filters<F63>(w, kernel, depth, columns)
-                                 : transform_filters<F43>(w, kernel, depth, columns));
+      tile == WinogradTile::f6x6 ? transform_filters<F63>(w3, kernel, depth, columns)
+                                 : transform_filters<F43>(w3, kernel, depth, columns));
   entry = filters;
   return filters;
 }
@@ -172,8 +196,11 @@ ChannelPlacement::ChannelPlacement(ChannelLayout layout, int c, int height, int 
   partial_last_group = layout == ChannelLayout::nhwc && c % kLanes != 0;
 }
 
-bool WinogradConv::handles(const ConvWeights& w, const ConvParams& p) {
-  return w.kernel_h == 3 && w.kernel_w == 3 && p.stride == 1 && p.pad == 1;
+bool WinogradConv::handles(const ConvWeights& w, const ConvParams& p, int height, int width) {
+  if (w.kernel_h != w.kernel_w || w.kernel_h != 3 * p.stride || p.pad != p.stride) return false;
+  // A strided one by its space-to-depth view: whole phases, and eight channels of one phase
+  // side by side in memory.
+  return p.stride == 1 || (w.in_channels % kLanes == 0 && height % p.stride == 0 && width % p.stride == 0);
 }
 
 WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height, int width,
@@ -182,19 +209,22 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
     : tile_(tile),
       output_tile_(output_tile_of(tile)),
       points_(points_of(tile)),
-      height_(height),
-      width_(width),
+      stride_(p.stride),
+      height_(height / p.stride),
+      width_(width / p.stride),
       input_(input_layout, w.in_channels, height, width),
-      output_(output_layout, w.out_channels, height, width),
-      in_channels_(round_up(w.in_channels, kLanes)),
+      output_(output_layout, w.out_channels, height_, width_),
+      in_channels_(round_up(w.in_channels * p.stride * p.stride, kLanes)),
       out_channels_(round_up(w.out_channels, output_layout == ChannelLayout::blocked16 ? 2 * kLanes : kLanes)),
       kernel_(&gemm_kernel()),
       gemm_columns_(round_up(w.out_channels, kernel_->panel)),
       activation_(p.activation),
       accumulate_(p.accumulate) {
-  if (!handles(w, p)) throw std::logic_error("WinogradConv: not a stride-1, pad-1 3x3 convolution");
+  if (!handles(w, p, height, width)) {
+    throw std::logic_error("WinogradConv: neither a stride-1, pad-1 3x3 convolution nor one by space-to-depth");
+  }
   threads_ = std::max(1, omp_get_max_threads());
-  const Blocking b = blocking_for(tile, in_channels_, gemm_columns_, height, width, kernel_->rows, threads_);
+  const Blocking b = blocking_for(tile, in_channels_, gemm_columns_, height_, width_, kernel_->rows, threads_);
   tiles_x_ = b.tiles_x;
   tiles_ = b.tiles;
   block_tiles_ = b.block_tiles;
@@ -205,7 +235,7 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
   workspace_ = arena.make(dnnl::memory::desc({static_cast<dnnl::memory::dim>(thread_floats_) * threads_},
                                              dnnl::memory::data_type::f32, dnnl::memory::format_tag::a));
 
-  filters_ = shared_filters(w, *kernel_, in_channels_, gemm_columns_, tile_);
+  filters_ = shared_filters(w, *kernel_, in_channels_, gemm_columns_, tile_, stride_);
   bias_.assign(static_cast<std::size_t>(gemm_columns_), 0.f);
   std::copy(w.bias.begin(), w.bias.end(), bias_.begin());
 }
@@ -215,7 +245,9 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
   constexpr int kInputTile = T::kInputTile, kOutputTile = T::kOutputTile, kPoints = T::kPoints;
   const std::size_t point_stride = input_stride_;
   const int groups = in_channels_ / kLanes;
-  const std::size_t row = static_cast<std::size_t>(width_) * input_.pixel;
+  // Steps between the (space-to-depth) view's pixels: s rows or columns of the input.
+  const std::size_t row = static_cast<std::size_t>(width_) * stride_ * stride_ * input_.pixel;
+  const std::size_t column = static_cast<std::size_t>(stride_) * input_.pixel;
   Float8 d[kPoints], v[kPoints];
   // Eight channels of one pixel; in NHWC the last group may hold fewer, the rest zeros.
   const auto load_group = [&](int group, std::size_t at) {
@@ -232,10 +264,14 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
     const int x0 = tile % tiles_x_ * kOutputTile - 1;
     const bool inside = y0 >= 0 && x0 >= 0 && y0 + kInputTile <= height_ && x0 + kInputTile <= width_;
     for (int g = 0; g < groups; ++g) {
+      // The group's phase (ry, rx) and first channel in the input (all zero at stride 1).
+      const int phase = g * kLanes / input_.channels * (stride_ > 1);
+      const int c = stride_ > 1 ? g * kLanes % input_.channels : g * kLanes;
+      const int ry = phase / stride_, rx = phase % stride_;
       if (inside) {
-        const std::size_t corner = input_.at(g * kLanes, y0, x0);
+        const std::size_t corner = input_.at(c, stride_ * y0 + ry, stride_ * x0 + rx);
         for (int i = 0; i < kInputTile; ++i) {
-          for (int j = 0; j < kInputTile; ++j) d[i * kInputTile + j] = load_group(g, corner + i * row + j * input_.pixel);
+          for (int j = 0; j < kInputTile; ++j) d[i * kInputTile + j] = load_group(g, corner + i * row + j * column);
         }
       } else {  // a border tile: the padding is zeros
         for (int i = 0; i < kInputTile; ++i) {
@@ -243,7 +279,7 @@ void WinogradConv::transform_inputs(const float* input, int first, int count, fl
           for (int j = 0; j < kInputTile; ++j) {
             const int x = x0 + j;
             const bool here = y >= 0 && y < height_ && x >= 0 && x < width_;
-            d[i * kInputTile + j] = here ? load_group(g, input_.at(g * kLanes, y, x)) : Float8{};
+            d[i * kInputTile + j] = here ? load_group(g, input_.at(c, stride_ * y + ry, stride_ * x + rx)) : Float8{};
           }
         }
       }

@@ -40,11 +40,14 @@ enum class WinogradTile { f4x4, f6x6 };
 
 class WinogradConv {
  public:
-  // True when these weights and parameters are a convolution this class computes.
-  static bool handles(const ConvWeights& weights, const ConvParams& params);
+  // True when these weights and parameters, on an input of this size, are a convolution this
+  // class computes: a stride-1, pad-1 3×3 one, or a stride-s one with a 3s kernel and pad s
+  // (the backbone's 6×6 stride-2 ones) on a multiple of 8 channels, by the space-to-depth view
+  // of its input, which makes it a 3×3 one on s²·C channels at 1/s the size.
+  static bool handles(const ConvWeights& weights, const ConvParams& params, int height, int width);
 
-  // Its workspace (the transformed tiles of a block per thread) is a buffer of the arena's
-  // current region, alive until released.
+  // height and width are the input's. Its workspace (the transformed tiles of a block per
+  // thread) is a buffer of the arena's current region, alive until released.
   WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width,
                ChannelLayout input_layout, ChannelLayout output_layout, WinogradTile tile, ScratchArena& arena);
 
@@ -77,7 +80,8 @@ class WinogradConv {
 
   WinogradTile tile_;
   int output_tile_, points_;  // the tile form's output side and points per tile
-  int height_, width_;
+  int stride_;
+  int height_, width_;       // the output's (the space-to-depth view's)
   ChannelPlacement input_, output_;
   int in_channels_;      // padded to 8
   int out_channels_;     // padded to the output's block (8 in NHWC): what is written
