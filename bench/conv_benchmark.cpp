@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   const double peak = sgemm_peak_gflops(runs);
   std::printf("size %dx%d, threads %d, sgemm peak %.1f GFLOP/s\n", width, height, threads, peak);
   // f4_ms, f6_ms: Winograd F(4×4) and F(6×6) on the layer; tile: the form the plan picks
-  // (WinogradConv::faster_tile), which the wino GFLOP/s and x_direct columns describe.
+  // (dnnl/conv_op.cpp), which the wino GFLOP/s and x_direct columns describe.
   std::printf("%-36s %5s %5s %9s %9s %8s %8s %4s %7s %7s %7s\n", "layer", "in", "out", "HxW", "direct_ms", "f4_ms",
               "f6_ms", "tile", "direct", "wino", "x_direct");
   std::vector<Layer> layers;
@@ -148,7 +148,9 @@ int main(int argc, char** argv) {
     const double direct = time_conv(weights, l.stride, ih, iw, CpuConvolution::direct, tag::nChw16c, runs);
     const double wino4 = time_conv(weights, l.stride, ih, iw, CpuConvolution::winograd4, tag::nChw8c, runs);
     const double wino6 = time_conv(weights, l.stride, ih, iw, CpuConvolution::winograd6, tag::nChw8c, runs);
-    const bool six = WinogradConv::faster_tile(l.in * l.stride * l.stride, l.out, h, w) == WinogradTile::f6x6;
+    // The plan's choice: F(6×6) only on the 1/8 refinement's layers (ConvParams::repeated).
+    const bool repeated = l.name.rfind("refine_s8", 0) == 0;
+    const bool six = repeated && WinogradConv::faster_tile(l.in * l.stride * l.stride, l.out, h, w) == WinogradTile::f6x6;
     const double wino = six ? wino6 : wino4;
     const double flops = 2.0 * h * w * l.in * l.out * k * k;
     char hw[32];

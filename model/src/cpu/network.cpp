@@ -38,9 +38,9 @@ NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width, CpuConv
       encoder_(w, height, width, first_region(context_, "encoder")),
       attention_(w, height / 16, width / 16, next_region(context_, "cross_attention")),
       matching_(height / 16, width / 16, kFeatures, next_region(context_, "global_matching")),
-      refine_s16_(w.refine_s16, height / 16, width / 16, next_region(context_, "refine_s16")),
+      refine_s16_(w.refine_s16, height / 16, width / 16, Iterations{}.s16, next_region(context_, "refine_s16")),
       merge_(w, height / 8, width / 8, next_region(context_, "merge_refine_s8")),
-      refine_s8_(w.refine_s8, height / 8, width / 8, context_),  // same region: it reads the merges' outputs
+      refine_s8_(w.refine_s8, height / 8, width / 8, Iterations{}.s8, context_),  // same region: it reads the merges' outputs
       upsampler_(w, height / 8, width / 8, next_region(context_, "upsampler")),
       context16_(height / 16, width / 16, kContext),
       flow8_(height / 8, width / 8, 2) {

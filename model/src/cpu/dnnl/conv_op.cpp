@@ -60,13 +60,17 @@ bool use_winograd(const ConvWeights& w, const ConvParams& p, int height, int wid
   return choice != CpuConvolution::automatic || w.in_channels >= kWinogradMinInputChannels;
 }
 
-// F(6×6, 3×3) where its share of the products is smaller, F(4×4, 3×3) where its tiles fit the
-// image with less overhang; both stay within the error bound of tests/model/winograd_conv_test.cpp.
-// (height, width: the output's; a strided layer's products have s² times its input channels.)
-WinogradTile winograd_tile(CpuConvolution choice, const ConvWeights& w, int stride, int height, int width) {
-  if (choice == CpuConvolution::winograd4) return WinogradTile::f4x4;
+// On layers that run several times a pair, F(6×6, 3×3) where its share of the products is
+// smaller and F(4×4, 3×3) where its tiles fit the image with less overhang; F(4×4) elsewhere
+// (see ConvParams::repeated). Both stay within the error bound of
+// tests/model/winograd_conv_test.cpp. (height, width: the output's; a strided layer's
+// products have s² times its input channels.)
+WinogradTile winograd_tile(CpuConvolution choice, const ConvWeights& w, const ConvParams& p, int height, int width) {
+  if (choice == CpuConvolution::winograd4 || (choice != CpuConvolution::winograd6 && !p.repeated)) {
+    return WinogradTile::f4x4;
+  }
   if (choice == CpuConvolution::winograd6) return WinogradTile::f6x6;
-  return WinogradConv::faster_tile(w.in_channels * stride * stride, w.out_channels, height, width);
+  return WinogradConv::faster_tile(w.in_channels * p.stride * p.stride, w.out_channels, height, width);
 }
 
 }  // namespace
@@ -104,7 +108,7 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
           eng));
     }
     winograd_.emplace(w, winograd_params, in_h, in_w, *winograd_layout(in_desc), *winograd_layout(out_desc),
-                      winograd_tile(context.convolution, w, p.stride, out_h_, out_w_), arena);
+                      winograd_tile(context.convolution, w, p, out_h_, out_w_), arena);
     dst_ = arena.make(out_desc);
     return;
   }

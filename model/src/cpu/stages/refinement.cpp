@@ -13,7 +13,8 @@ constexpr int kFlowOffset = kCorrChannels + kHiddenChannels;
 constexpr float kHiddenClamp = 4.f;
 }  // namespace
 
-Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& context) {
+Refinement::Refinement(const RefineWeights& w, int h, int width, int iterations, PlanContext& context) {
+  const bool repeated = iterations > 1;
   // In the arena: begin() and step() write each of them whole before anything reads it.
   context.arena.make_tensor(input_, h, width, kRefineDynamicChannels);
   context.arena.make_tensor(constant_, h, width, kRefineConstantChannels);
@@ -25,20 +26,21 @@ Refinement::Refinement(const RefineWeights& w, int h, int width, PlanContext& co
   conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), context);
   conv1_constant_->release_scratch(arena);
   arena.release(constant_);  // read in begin() only
-  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true}, nhwc_desc(h, width, input_.c), context,
+  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true, repeated}, nhwc_desc(h, width, input_.c), context,
                  conv1_constant_->output_desc());
   conv1_->release_scratch(arena);
-  conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu}, conv1_->output_desc(), context);
+  conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu, false, repeated}, conv1_->output_desc(), context);
   conv2_->release_scratch(arena);
   arena.release(conv1_->output());
   const ConvOp* prev = &*conv2_;
   for (std::size_t i = 0; i < layers_.size(); ++i) {
-    layers_[i].emplace(w.conv_layers[i], ConvParams{1, 1, Activation::leaky_relu}, prev->output_desc(), context);
+    layers_[i].emplace(w.conv_layers[i], ConvParams{1, 1, Activation::leaky_relu, false, repeated}, prev->output_desc(),
+                       context);
     layers_[i]->release_scratch(arena);
     arena.release(prev->output());
     prev = &*layers_[i];
   }
-  conv3_.emplace(w.conv3, ConvParams{1, 1, Activation::none}, prev->output_desc(), context);
+  conv3_.emplace(w.conv3, ConvParams{1, 1, Activation::none, false, repeated}, prev->output_desc(), context);
   arena.make_tensor(output_, h, width, w.conv3.out_channels);  // written while conv3 runs
   conv3_->release_scratch(arena);
   arena.release(prev->output());

@@ -16,7 +16,9 @@ namespace neuflow::model {
 
 class Refinement {
  public:
-  Refinement(const RefineWeights& weights, int h, int w, PlanContext& context);
+  // iterations: how many steps a pair usually runs (the session's default at this scale);
+  // above one, the per-step convolutions are marked ConvParams::repeated.
+  Refinement(const RefineWeights& weights, int h, int w, int iterations, PlanContext& context);
 
   // Starts a pair: context [h, w, 64]; hidden state reset to zero.
   void begin(dnnl::stream& stream, const Tensor& context);
