@@ -42,7 +42,8 @@ class InferenceBackend {
   virtual std::vector<StageTime> take_stage_times() { return {}; }
 };
 
-// `convolution` automatic defers to NEUFLOW_CONV (auto, direct or winograd) when it is set.
+// `convolution` automatic defers to NEUFLOW_CONV (auto, direct, winograd, winograd4 or
+// winograd6) when it is set.
 std::unique_ptr<InferenceBackend> make_cpu_backend(const FlowModel& model, int height, int width,
                                                    CpuConvolution convolution);
 // The choice a session's plan is built with: `requested`, or for automatic, NEUFLOW_CONV's

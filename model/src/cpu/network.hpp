@@ -19,7 +19,7 @@ namespace neuflow::model {
 class NetworkPlan {
  public:
   // height, width: multiples of 16, at least 32. `convolution`: how the stride-1 3×3
-  // convolutions are computed (automatic, direct or winograd; never read from the environment here).
+  // convolutions are computed (any CpuConvolution; never read from the environment here).
   NetworkPlan(const NetworkWeights& weights, int height, int width, CpuConvolution convolution);
 
   int height() const { return height_; }

@@ -24,8 +24,8 @@ enum class Precision { fp32, fp16 };
 
 // How the CPU backend computes its stride-1 3×3 convolutions, most of the network's
 // arithmetic: `automatic` by Winograd on the layers where that measured faster than oneDNN's
-// direct convolution, each layer with the tile form (F(4×4, 3×3) or F(6×6, 3×3)) that
-// measured faster at its size, unless the environment's NEUFLOW_CONV (auto, direct,
+// direct convolution, F(4×4, 3×3), or F(6×6, 3×3) on the 1/8 refinement's layers where it
+// computes fewer products at that size, unless the environment's NEUFLOW_CONV (auto, direct,
 // winograd, winograd4 or winograd6) says otherwise; `direct` by oneDNN everywhere (the
 // reference path for tests and benchmarks); `winograd` by Winograd on every such layer, tile
 // forms chosen as `automatic` does; `winograd4` and `winograd6` by one tile form everywhere,
