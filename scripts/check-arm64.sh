@@ -136,7 +136,7 @@ long_ones+='|ConvertCli\.(ShardsTogether.*|FolderInNaturalOrder.*|FrameRangesTog
 long_ones+='|ResumeRecomputesOnlyMissingOrIncompleteFlows|VideoGivesFlowsAndAnMp4ThatDecodes|MaxFramesLimitsEachInput'
 long_ones+='|BadInputsFailAloneAndAreNamed|ImagePairAsTwoFilesOrWithPair|ResumeRebuildsTheVideoFromKeptFlows'
 long_ones+='|KittiFlowsAndPngRenderings)|SessionTest\.StreamingGivesTheSameFlowAsPairs'
-long_ones+='|EvalModel\.ChannelOrderChangesWhatTheNetworkSees|WinogradConv\.MatchesDirectAtEveryNetworkLayer)$'
+long_ones+='|EvalModel\.ChannelOrderChangesWhatTheNetworkSees|WinogradConv/WinogradTileForm\.MatchesDirectAtEveryNetworkLayer/.*)$'
 exclude="$always_out"
 [ "$run_all" -eq 1 ] || exclude="$always_out|$long_ones"
 unset NEUFLOW_REQUIRE_VULKAN
