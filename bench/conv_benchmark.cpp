@@ -1,4 +1,5 @@
-// Each stride-1 3×3 convolution of NeuFlow-V2 at its real shape for one model size, computed
+// Each convolution of NeuFlow-V2 that Winograd can compute (the stride-1 3×3 ones and the 6×6
+// stride-2 one on 192 channels) at its real shape for one model size, computed
 // by oneDNN's direct convolution and by Winograd F(4×4, 3×3) and F(6×6, 3×3), in the same
 // run: the table from which the CPU backend chooses per layer (model/src/cpu/dnnl/conv_op.cpp,
 // WinogradConv::faster_tile). Times are the best of several runs; GFLOP/s counts the direct
@@ -149,7 +150,8 @@ int main(int argc, char** argv) {
     const double wino4 = time_conv(weights, l.stride, ih, iw, CpuConvolution::winograd4, tag::nChw8c, runs);
     const double wino6 = time_conv(weights, l.stride, ih, iw, CpuConvolution::winograd6, tag::nChw8c, runs);
     // The plan's choice: F(6×6) only on the 1/8 refinement's layers (ConvParams::repeated).
-    const bool repeated = l.name.rfind("refine_s8", 0) == 0;
+    const bool repeated = l.name.rfind("refine_s8", 0) == 0 && l.name != "refine_s8.conv1.conv" &&
+                          l.name.find("(per pair)") == std::string::npos;
     const bool six = repeated && WinogradConv::faster_tile(l.in * l.stride * l.stride, l.out, h, w) == WinogradTile::f6x6;
     const double wino = six ? wino6 : wino4;
     const double flops = 2.0 * h * w * l.in * l.out * k * k;

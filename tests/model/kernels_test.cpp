@@ -148,9 +148,11 @@ INSTANTIATE_TEST_SUITE_P(NetworkShapes, ConvOpTest,
                                            ConvCase{40, 24, 3, 1, 1, 5, 5, false, Activation::gelu, false},
                                            // Several tiles, borders cut inside a tile, channels past one block.
                                            ConvCase{20, 36, 3, 1, 1, 13, 18, true, Activation::leaky_relu, true},
-                                           // 6×6 stride 2 (block_8_16): by space-to-depth on 16 channels,
+                                           // 6×6 stride 2 (block_8_16): by space-to-depth on 16 channels
+                                           // (a 7×9 view: border tiles only; 15×17: whole ones too),
                                            // and on an odd-sized input, directly.
                                            ConvCase{16, 24, 6, 2, 2, 14, 18, true, Activation::leaky_relu, false},
+                                           ConvCase{16, 24, 6, 2, 2, 30, 34, true, Activation::leaky_relu, false},
                                            ConvCase{16, 24, 6, 2, 2, 13, 18, true, Activation::leaky_relu, false}),
                                            ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd4,
                                                              CpuConvolution::winograd6)));

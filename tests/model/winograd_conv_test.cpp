@@ -113,47 +113,59 @@ TEST_P(WinogradTileForm, MatchesDirectAtEveryNetworkLayer) {
 
 // Winograd reads and writes NHWC, nChw8c and nChw16c in place; channel counts that are not
 // multiples of 8 or 16 leave partial groups at the end of each pixel (NHWC) or padding
-// channels (blocked, which must be written as zeros).
+// channels (blocked, which must be written as zeros). Twice: a 3×3 layer, and a 6×6 stride-2
+// one by space-to-depth on 24 channels (eight-channel groups straddle a 16-channel block; a
+// 15×17 view, so whole tiles as well as border ones).
 TEST_P(WinogradTileForm, EveryLayoutInAndOutGivesTheDirectResult) {
-  constexpr int kIn = 147, kOut = 66, kH = 13, kW = 18;
-  std::mt19937 rng(11);
-  std::normal_distribution<float> normal(0.f, 1.f);
-  ConvWeights weights{kOut, kIn, 3, 3, std::vector<float>(static_cast<std::size_t>(kOut) * kIn * 9),
-                      std::vector<float>(static_cast<std::size_t>(kOut))};
-  for (auto& v : weights.weight) v = normal(rng) / 36.f;
-  for (auto& v : weights.bias) v = normal(rng);
-  Tensor input(kH, kW, kIn);
-  for (auto& v : input.data) v = normal(rng);
-  bool used = false;
-  const Tensor direct = convolve(weights, input, CpuConvolution::direct, used);
-  dnnl::stream stream(cpu_engine());
-  for (const tag in_tag : {tag::nhwc, tag::nChw8c, tag::nChw16c}) {
-    for (const tag out_tag : {tag::nhwc, tag::nChw8c, tag::nChw16c}) {
-      SCOPED_TRACE("input " + std::to_string(static_cast<int>(in_tag)) + ", output " + std::to_string(static_cast<int>(out_tag)));
-      const dnnl::memory::desc in_desc({1, kIn, kH, kW}, dnnl::memory::data_type::f32, in_tag);
-      const dnnl::memory::desc out_desc({1, kOut, kH, kW}, dnnl::memory::data_type::f32, out_tag);
-      PlanContext context{{}, GetParam()};
-      ConvOp op(weights, {1, 1, Activation::leaky_relu}, in_desc, context, out_desc);
-      context.arena.finalize();
-      ASSERT_TRUE(op.is_winograd());
-      // The output's padding channels start as garbage: Winograd must leave them zero.
-      std::memset(op.output().get_data_handle(), 0x7f, out_desc.get_size());
-      Tensor in_copy = input;
-      dnnl::memory nhwc_in = wrap_nhwc(in_copy), laid_out(in_desc, cpu_engine());
-      dnnl::reorder(nhwc_in, laid_out).execute(stream, nhwc_in, laid_out);
-      Tensor out;
-      op.run_to_nhwc(stream, laid_out, out);
-      stream.wait();
-      for (std::size_t i = 0; i < direct.data.size(); ++i) {
-        const float d = direct.data[i] < 0 ? 0.1f * direct.data[i] : direct.data[i];
-        ASSERT_NEAR(out.data[i], d, 1e-4f * (1.f + std::fabs(d))) << "at " << i;
-      }
-      if (out_tag != tag::nhwc) {
+  struct Shape {
+    int in, out, stride, h, w;  // h, w: the input's
+  };
+  for (const Shape shape : {Shape{147, 66, 1, 13, 18}, Shape{24, 40, 2, 30, 34}}) {
+    SCOPED_TRACE("stride " + std::to_string(shape.stride));
+    const int k = 3 * shape.stride, oh = shape.h / shape.stride, ow = shape.w / shape.stride;
+    std::mt19937 rng(11);
+    std::normal_distribution<float> normal(0.f, 1.f);
+    ConvWeights weights{shape.out, shape.in, k, k, std::vector<float>(static_cast<std::size_t>(shape.out) * shape.in * k * k),
+                        std::vector<float>(static_cast<std::size_t>(shape.out))};
+    for (auto& v : weights.weight) v = normal(rng) / static_cast<float>(4 * k * k);
+    for (auto& v : weights.bias) v = normal(rng);
+    Tensor input(shape.h, shape.w, shape.in);
+    for (auto& v : input.data) v = normal(rng);
+    bool used = false;
+    const Tensor direct = convolve(weights, input, CpuConvolution::direct, used);
+    dnnl::stream stream(cpu_engine());
+    for (const tag in_tag : {tag::nhwc, tag::nChw8c, tag::nChw16c}) {
+      for (const tag out_tag : {tag::nhwc, tag::nChw8c, tag::nChw16c}) {
+        SCOPED_TRACE("input " + std::to_string(static_cast<int>(in_tag)) + ", output " +
+                     std::to_string(static_cast<int>(out_tag)));
+        const dnnl::memory::desc in_desc({1, shape.in, shape.h, shape.w}, dnnl::memory::data_type::f32, in_tag);
+        const dnnl::memory::desc out_desc({1, shape.out, oh, ow}, dnnl::memory::data_type::f32, out_tag);
+        PlanContext context{{}, GetParam()};
+        ConvOp op(weights, {shape.stride, shape.stride, Activation::leaky_relu}, in_desc, context, out_desc);
+        context.arena.finalize();
+        ASSERT_TRUE(op.is_winograd());
+        // The output's padding channels start as garbage: Winograd must leave them zero.
+        std::memset(op.output().get_data_handle(), 0x7f, out_desc.get_size());
+        Tensor in_copy = input;
+        dnnl::memory nhwc_in = wrap_nhwc(in_copy), laid_out(in_desc, cpu_engine());
+        dnnl::reorder(nhwc_in, laid_out).execute(stream, nhwc_in, laid_out);
+        Tensor out;
+        op.run_to_nhwc(stream, laid_out, out);
+        stream.wait();
+        ASSERT_EQ(out.data.size(), direct.data.size());
+        for (std::size_t i = 0; i < direct.data.size(); ++i) {
+          const float d = direct.data[i] < 0 ? 0.1f * direct.data[i] : direct.data[i];
+          ASSERT_NEAR(out.data[i], d, 1e-4f * (1.f + std::fabs(d))) << "at " << i;
+        }
         const int block = out_tag == tag::nChw16c ? 16 : 8;
-        const auto* raw = static_cast<const float*>(op.output().get_data_handle());
-        const std::size_t last_plane = static_cast<std::size_t>(kOut / block) * kH * kW * block;
-        for (int p = 0; p < kH * kW; ++p) {
-          for (int c = kOut % block; c < block; ++c) ASSERT_EQ(raw[last_plane + p * block + c], 0.f) << "padding channel";
+        if (out_tag != tag::nhwc && shape.out % block != 0) {
+          const auto* raw = static_cast<const float*>(op.output().get_data_handle());
+          const std::size_t last_plane = static_cast<std::size_t>(shape.out / block) * oh * ow * block;
+          for (int p = 0; p < oh * ow; ++p) {
+            for (int c = shape.out % block; c < block; ++c) {
+              ASSERT_EQ(raw[last_plane + p * block + c], 0.f) << "padding channel";
+            }
+          }
         }
       }
     }

@@ -38,10 +38,12 @@ std::size_t point_stride_for(int tiles, int channels) {
 }
 int divide_up(int v, int m) { return (v + m - 1) / m; }
 
-// A block's tiles: a thread's whole workspace (36 points of inputs and products) stays in
-// half of its core's L2, so what the input transform writes is still there when the products
-// read it, and what they write is still there for the output transform; the filters' panels
-// stream through the other half. Measured with neuflow-bench-conv on a 1 MiB-L2 core
+// A block's tiles: a thread's whole workspace (36 or 64 points of inputs and products) stays
+// within half of its core's L2 (or is one group of the kernel's rows of tiles, where even that
+// is larger: the widest layers), so what the input transform writes is still there when the
+// products read it, and what they write is still there for the output transform; the
+// filters' panels stream through the rest. (A core's L2 as the C library reports it; with two
+// hardware threads on a core each has less.) Measured with neuflow-bench-conv on a 1 MiB-L2 core
 // (docs/benchmarks.md): a 6 MiB workspace (blocks of ~170 tiles, living in L3) made the
 // network's Winograd layers 2.3–2.5× the direct ones, a 512 KiB one 2.8–3.0×; smaller
 // blocks read the filters more often, but those reads stream from L2 and L3 at the
@@ -209,9 +211,9 @@ WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height
     : tile_(tile),
       output_tile_(output_tile_of(tile)),
       points_(points_of(tile)),
-      stride_(p.stride),
-      height_(height / p.stride),
-      width_(width / p.stride),
+      stride_(std::max(p.stride, 1)),  // handles() below rejects what is not 1 or 3s-wide
+      height_(height / stride_),
+      width_(width / stride_),
       input_(input_layout, w.in_channels, height, width),
       output_(output_layout, w.out_channels, height_, width_),
       in_channels_(round_up(w.in_channels * p.stride * p.stride, kLanes)),

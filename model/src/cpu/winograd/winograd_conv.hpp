@@ -1,5 +1,6 @@
 #pragma once
-// A stride-1, pad-1 3×3 convolution by Winograd F(4×4, 3×3) or F(6×6, 3×3) for one input
+// A stride-1, pad-1 3×3 convolution (or a stride-s one with a 3s kernel and padding s, by the
+// space-to-depth view of its input) by Winograd F(4×4, 3×3) or F(6×6, 3×3) for one input
 // size, reading and writing the layouts its neighbours use (NHWC, oneDNN's nChw8c or
 // nChw16c), so no reorder sits between it and them. The filters are transformed once here.
 // run() splits the output's tiles into blocks, one thread a block: each block's inputs are
