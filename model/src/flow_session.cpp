@@ -2,6 +2,10 @@
 
 #include <omp.h>
 
+#include <algorithm>
+#include <deque>
+#include <exception>
+#include <string>
 #include <stdexcept>
 #include <utility>
 
@@ -23,7 +27,15 @@ struct FlowSession::State {
   int previous_slot = 0;
   bool has_previous = false;
   StageObserver observer;
-  std::vector<StageTime> stage_times;  // of the last compute() or push()
+  std::vector<StageTime> stage_times;  // of the last compute(), push() or take()
+  // Frames submitted and not taken, oldest first: on the backend still (started there), or
+  // finished with their result kept.
+  struct InFlight {
+    bool started = false;
+    std::optional<flow::FlowField> result;
+    FrameGeometry geometry;
+  };
+  std::deque<InFlight> in_flight;
 };
 
 namespace {
@@ -70,6 +82,16 @@ void FlowSession::set_observer(StageObserver observer) { state_->observer = std:
 
 void FlowSession::reset() { state_->has_previous = false; }
 
+int FlowSession::in_flight() const { return static_cast<int>(state_->in_flight.size()); }
+
+int FlowSession::max_in_flight() const {
+  // Before the first frame there is no backend yet: a session opened on a GPU pipelines
+  // (unless backend=auto leaves it for the CPU at the first frame).
+  const auto& s = *state_;
+  if (s.backend) return std::max(1, s.backend->stream_depth());
+  return s.vulkan ? kVulkanStreamDepth : 1;
+}
+
 const std::string& FlowSession::backend_description() const { return state_->description; }
 const std::string& FlowSession::fallback_warning() const { return state_->fallback; }
 const std::vector<StageTime>& FlowSession::device_stage_times() const { return state_->stage_times; }
@@ -81,6 +103,35 @@ void apply_threads(int threads) {
   if (threads > 0) omp_set_num_threads(threads);
 }
 
+// The flow of a frame the backend has finished, at the frame's own size.
+std::optional<flow::FlowField> finished_flow(FlowSession::State& s, const FrameGeometry& g) {
+  const Tensor* flow = s.backend->finish();
+  if (!flow) return std::nullopt;
+  return restore_flow(*flow, g);
+}
+
+// Finishes the frames submitted and still on the backend, keeping their results. One that
+// fails is lost (the others are finished still, so the backend is idle after) and the first
+// failure is thrown.
+void finish_started(FlowSession::State& s) {
+  std::exception_ptr failure;
+  for (auto it = s.in_flight.begin(); it != s.in_flight.end();) {
+    if (!it->started) {
+      ++it;
+      continue;
+    }
+    try {
+      it->result = finished_flow(s, it->geometry);
+      it->started = false;
+      ++it;
+    } catch (...) {
+      if (!failure) failure = std::current_exception();
+      it = s.in_flight.erase(it);
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+
 // Makes the state ready for frames of this size: a new size ends the stream, and a new
 // model size replaces the plan (the old one's buffers are released first). With
 // backend=auto, a GPU that cannot hold this size leaves the session on the CPU.
@@ -88,6 +139,7 @@ const FrameGeometry& prepare_plan(FlowSession::State& s, const FlowModel& model,
                                   int width, int height) {
   const FrameGeometry g = plan_geometry(width, height, options);
   if (s.backend && g == s.geometry) return s.geometry;
+  finish_started(s);  // their passes use the plan about to be replaced
   if (!s.backend || s.backend->width() != g.model_width || s.backend->height() != g.model_height) {
     s.backend.reset();
     if (s.vulkan) {
@@ -134,6 +186,7 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   }
   apply_threads(options_.threads);
   auto& s = *state_;
+  finish_started(s);  // the backend computes pairs with nothing of the stream outstanding
   const FrameGeometry& g = prepare_plan(s, *model_, options_, frame0.width, frame0.height);
   s.stage_times.clear();
   s.backend->take_stage_times();  // what a call that failed half-way left
@@ -147,18 +200,29 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   return restore_flow(model_flow, g);
 }
 
+namespace {
+
+// The slot a stream's next frame goes to. A stream alternates between slots 0 and 1, so the
+// third (what compute() takes while a stream is open) holds no features unless compute() is
+// used: 48 MB at 1920×1088 on the CPU. A pipelined step may reuse the slot its predecessor
+// still reads: the device runs them in order.
+int next_stream_slot(const FlowSession::State& s) { return s.previous_slot == 0 ? 1 : 0; }
+
+}  // namespace
+
 std::optional<flow::FlowField> FlowSession::push(const ImageView& frame) { return push(frame, options_.iterations); }
 
 std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const Iterations& iterations) {
+  if (!state_->in_flight.empty()) {
+    throw std::logic_error("FlowSession::push with submitted frames not yet taken: take() them first");
+  }
   validate(iterations);
   apply_threads(options_.threads);
   auto& s = *state_;
   const FrameGeometry& g = prepare_plan(s, *model_, options_, frame.width, frame.height);
   s.stage_times.clear();
   s.backend->take_stage_times();
-  // A stream alternates between slots 0 and 1, so the third (what compute() takes while a
-  // stream is open) holds no features unless compute() is used: 48 MB at 1920×1088 on the CPU.
-  const int current = s.previous_slot == 0 ? 1 : 0;
+  const int current = next_stream_slot(s);
   check_image(frame, g);
   encode(s, frame, g, options_.network_order, current);
   std::optional<flow::FlowField> result;
@@ -168,6 +232,54 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   keep_stage_times(s);
   s.previous_slot = current;
   s.has_previous = true;
+  return result;
+}
+
+void FlowSession::submit(const ImageView& frame) { submit(frame, options_.iterations); }
+
+void FlowSession::submit(const ImageView& frame, const Iterations& iterations) {
+  auto& s = *state_;
+  if (in_flight() >= max_in_flight()) {
+    throw std::logic_error("FlowSession::submit: " + std::to_string(in_flight()) +
+                           " frames are waiting to be taken, the most in flight");
+  }
+  validate(iterations);
+  apply_threads(options_.threads);
+  const FrameGeometry& g = prepare_plan(s, *model_, options_, frame.width, frame.height);
+  check_image(frame, g);
+  if (s.backend->stream_depth() == 0 || s.observer) {
+    // Computed now: through push(), once the frames before it are finished (kept in order).
+    finish_started(s);
+    std::deque<State::InFlight> earlier;
+    std::swap(earlier, s.in_flight);
+    std::optional<flow::FlowField> result;
+    try {
+      result = push(frame, iterations);
+    } catch (...) {
+      std::swap(earlier, s.in_flight);
+      throw;
+    }
+    std::swap(earlier, s.in_flight);
+    s.in_flight.push_back({false, std::move(result), g});
+    return;
+  }
+  s.backend->take_stage_times();
+  const int current = next_stream_slot(s);
+  s.backend->start({frame, g, options_.network_order, current, s.has_previous ? s.previous_slot : -1, iterations});
+  s.in_flight.push_back({true, std::nullopt, g});
+  s.previous_slot = current;
+  s.has_previous = true;
+}
+
+std::optional<flow::FlowField> FlowSession::take() {
+  auto& s = *state_;
+  if (s.in_flight.empty()) throw std::logic_error("FlowSession::take: no frame submitted");
+  State::InFlight f = std::move(s.in_flight.front());
+  s.in_flight.pop_front();
+  if (!f.started) return std::move(f.result);
+  s.stage_times.clear();
+  std::optional<flow::FlowField> result = finished_flow(s, f.geometry);
+  keep_stage_times(s);
   return result;
 }
 

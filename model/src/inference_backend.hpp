@@ -4,6 +4,7 @@
 // keeps the features of up to kSlots encoded frames, so the session can stream (each frame
 // encoded once, serving two pairs) and compute pairs without disturbing the stream.
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,26 @@ class InferenceBackend {
   // The device's own time for each stage of the passes since the last call, where the backend
   // measures one (the GPU's timestamps); the CPU's stages are timed with an observer instead.
   virtual std::vector<StageTime> take_stage_times() { return {}; }
+
+  // Pipelined streaming (FlowSession::submit): a backend that overlaps frames starts a step
+  // (the frame's encoding into `slot` and, unless previous is -1, its pair) without waiting,
+  // and finishes the steps in order. stream_depth(): how many may be unfinished; 0 where the
+  // backend does not pipeline (the session then streams through encode() and flow()).
+  struct StreamStep {
+    ImageView frame;
+    FrameGeometry geometry;
+    ChannelOrder network_order;
+    int slot = 0, previous = -1;
+    Iterations iterations;
+  };
+  virtual int stream_depth() const { return 0; }
+  virtual void start(const StreamStep& /*step*/) {
+    throw std::logic_error("InferenceBackend::start on a backend that does not pipeline");
+  }
+  // The oldest started step's flow, valid until the backend's next call; nullptr without a pair.
+  virtual const Tensor* finish() {
+    throw std::logic_error("InferenceBackend::finish on a backend that does not pipeline");
+  }
 };
 
 // `convolution` automatic defers to NEUFLOW_CONV (auto, direct, winograd, winograd4 or

@@ -34,10 +34,32 @@ class VulkanBackend final : public InferenceBackend {
   }
   std::vector<StageTime> take_stage_times() override { return network_.take_stage_times(); }
 
+  static_assert(kVulkanStreamDepth == vulkan::VulkanNetwork::kRing);
+  int stream_depth() const override { return vulkan::VulkanNetwork::kRing; }
+  void start(const StreamStep& step) override {
+    vulkan::VulkanNetwork::Step s;
+    s.slot = step.slot;
+    s.previous = step.previous;
+    s.iterations = step.iterations;
+    const ImageView& image = step.frame;
+    const vulkan::VulkanNetwork::Frame frame{image.data, image.stride,
+                                             {image.width, image.height, step.geometry.pad_left, step.geometry.pad_top,
+                                              image.order != step.network_order}};
+    if (step.geometry.resize) {  // as in encode_frame(): the resize stays on the CPU
+      prepare_input(image, step.geometry, step.network_order, converted_);
+      s.image = &converted_;
+    } else {
+      s.frame = &frame;
+    }
+    network_.start(s);
+  }
+  const Tensor* finish() override { return network_.finish(flow_) ? &flow_ : nullptr; }
+
  private:
   std::shared_ptr<VulkanContext> context_;
   vulkan::VulkanNetwork network_;
-  Tensor flow_;  // the last pair's, read back from the device
+  Tensor flow_;       // the last pair's, read back from the device
+  Tensor converted_;  // a resized frame, converted here before its upload
 };
 
 }  // namespace

@@ -17,6 +17,8 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
                                            Precision precision, std::string& note);
 // "vulkan device 0 (NVIDIA H200)", with ", fp16" when it stores fp16.
 std::string describe(const VulkanContext& context);
+// How many streamed frames a Vulkan backend keeps in flight (its staging ring).
+inline constexpr int kVulkanStreamDepth = 2;
 // Throws BackendError (out of memory, ...).
 std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<VulkanContext>& context, int height,
                                                       int width);

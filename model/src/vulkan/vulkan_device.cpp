@@ -305,6 +305,11 @@ void VulkanDevice::release(Buffer& b) {
 }
 
 void VulkanDevice::submit_and_wait(VkCommandBuffer commands, VkFence fence) {
+  submit(commands, fence);
+  wait(fence);
+}
+
+void VulkanDevice::submit(VkCommandBuffer commands, VkFence fence) {
   if (lost_) {
     throw BackendError(BackendError::Kind::device_lost, label_ + ": the device was lost earlier; start a new session");
   }
@@ -314,15 +319,20 @@ void VulkanDevice::submit_and_wait(VkCommandBuffer commands, VkFence fence) {
   VkResult r;
   {
     // Sessions on one device share its queue, which Vulkan requires to be used by one thread
-    // at a time; the wait happens outside the lock so their work overlaps on the device.
+    // at a time; waits happen outside the lock so their work overlaps on the device.
     const std::lock_guard lock(queue_mutex_);
     const bool lose_now = lose_after_ >= 0 && submissions_++ >= lose_after_;
     r = lose_now ? VK_ERROR_DEVICE_LOST : vkQueueSubmit(queue_, 1, &submit, fence);
   }
-  if (r == VK_SUCCESS) r = vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX);
+  if (r == VK_ERROR_DEVICE_LOST) lost_ = true;
+  check(r, "running the network (vkQueueSubmit)");
+}
+
+void VulkanDevice::wait(VkFence fence) {
+  VkResult r = vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX);
   if (r == VK_SUCCESS) r = vkResetFences(device_, 1, &fence);
   if (r == VK_ERROR_DEVICE_LOST) lost_ = true;
-  check(r, "running the network (vkQueueSubmit/vkWaitForFences)");
+  check(r, "running the network (vkWaitForFences)");
 }
 
 }  // namespace neuflow::model::vulkan

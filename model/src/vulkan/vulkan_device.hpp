@@ -75,6 +75,10 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   // fails and open() creates a new device. NEUFLOW_VULKAN_LOSE_DEVICE_AFTER=N, when a device is
   // opened, makes it report itself lost at its (N+1)th submission (to test that path).
   void submit_and_wait(VkCommandBuffer commands, VkFence fence);
+  // The two halves of submit_and_wait(), for work the host overlaps with its own: submit()
+  // signals `fence` when done; wait() waits for it and leaves it unsignalled again.
+  void submit(VkCommandBuffer commands, VkFence fence);
+  void wait(VkFence fence);
 
   // Throws if `where` failed, naming this device.
   void check(VkResult result, std::string_view call) const;

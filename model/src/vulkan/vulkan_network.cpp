@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 
 #include "vulkan/half_float.hpp"
 #include "vulkan/one_shot_commands.hpp"
@@ -57,18 +58,24 @@ uint32_t tiles(long count, const char* what) {
 class VulkanNetwork::Recorder {
  public:
   // marks: where the stages' timestamps go (nullptr: not timed, as with an observer).
+  // entry: the ring entry whose upload, read-back and timestamps the pass uses.
   Recorder(VulkanNetwork& net, VkCommandBuffer commands, const StageObserver* observer,
-           std::vector<std::string>* marks = nullptr)
+           std::vector<std::string>* marks = nullptr, int entry = 0)
       : net_(net),
         commands_(commands),
         observer_(observer && *observer ? observer : nullptr),
-        marks_(observer_ || net.timestamps_ == VK_NULL_HANDLE ? nullptr : marks) {
+        marks_(observer_ || net.timestamps_ == VK_NULL_HANDLE ? nullptr : marks),
+        transfer_(net.ring_[static_cast<std::size_t>(entry)]),
+        query_base_(static_cast<uint32_t>(entry) * kTimestamps) {
     begin();
     if (marks_) {
-      vkCmdResetQueryPool(commands_, net_.timestamps_, 0, kTimestamps);
-      vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_, 0);
+      vkCmdResetQueryPool(commands_, net_.timestamps_, query_base_, kTimestamps);
+      vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_, query_base_);
     }
   }
+
+  const Buffer& upload() const { return transfer_.upload; }
+  const Buffer& readback() const { return transfer_.readback; }
 
   // The end of the stage `name`: a timestamp once everything recorded before it has run.
   // Consecutive names without work between them (the backbone's outputs that the flow pass
@@ -77,7 +84,7 @@ class VulkanNetwork::Recorder {
     if (!marks_ || !worked_ || marks_->size() + 1 >= kTimestamps) return;
     marks_->push_back(name);
     vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_,
-                        static_cast<uint32_t>(marks_->size()));
+                        query_base_ + static_cast<uint32_t>(marks_->size()));
     worked_ = false;
   }
 
@@ -89,7 +96,7 @@ class VulkanNetwork::Recorder {
   void end() { net_.device_.check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer"); }
   void run() {
     end();
-    net_.device_.submit_and_wait(commands_, net_.fence_);
+    net_.device_.submit_and_wait(commands_, transfer_.fence);
   }
 
   // Makes a copy into a host-visible buffer visible to the host once the fence has signalled.
@@ -204,11 +211,11 @@ class VulkanNetwork::Recorder {
     barrier();
     const VkDeviceSize e = net_.elem_;
     const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
-    vkCmdCopyBuffer(commands_, v.buffer->handle(), net_.readback_.handle(), 1, &region);
+    vkCmdCopyBuffer(commands_, v.buffer->handle(), transfer_.readback.handle(), 1, &region);
     host_barrier();
     run();
     net_.staging_.resize(static_cast<std::size_t>(v.count()));
-    net_.load(net_.readback_.mapped(), net_.staging_.size(), net_.staging_.data());
+    net_.load(transfer_.readback.mapped(), net_.staging_.size(), net_.staging_.data());
     const float* planar = net_.staging_.data();
     const std::size_t plane = static_cast<std::size_t>(v.h) * v.w;
     nhwc_.resize(plane * v.c);
@@ -225,6 +232,8 @@ class VulkanNetwork::Recorder {
   VkCommandBuffer commands_;
   const StageObserver* observer_;
   std::vector<std::string>* marks_;
+  const Transfer& transfer_;
+  uint32_t query_base_;
   bool worked_ = false;  // commands recorded since the last timestamp
   std::vector<float> nhwc_;
 };
@@ -251,8 +260,11 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   };
   dummy_ = make(4, "a placeholder binding");
   zeros_ = make(kHidden * hw8 + 2, "zeros");
-  upload_ = make(3 * hw, "the frame upload", M::upload);
-  readback_ = make(std::max(192 * hw8, 2 * hw), "the read-back buffer", M::readback);
+  for (std::size_t e = 0; e < ring_.size(); ++e) {
+    ring_[e].upload = make(3 * hw, "the frame upload", M::upload);
+    // Entry 0 also serves the observer, which reads whole stages back.
+    ring_[e].readback = make(e == 0 ? std::max(192 * hw8, 2 * hw) : 2 * hw, "the read-back buffer", M::readback);
+  }
   input_ = make(3 * hw, "the input frame");
   half_ = make(3 * hw / 4, "the 1/2 frame");
   quarter_ = make(3 * hw / 16, "the 1/4 frame");
@@ -308,11 +320,11 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
     pool.queueFamilyIndex = device_.queue_family();
     device_.check(vkCreateCommandPool(device_.handle(), &pool, nullptr, &pool_), "vkCreateCommandPool");
     VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    device_.check(vkCreateFence(device_.handle(), &fence, nullptr, &fence_), "vkCreateFence");
+    for (auto& t : ring_) device_.check(vkCreateFence(device_.handle(), &fence, nullptr, &t.fence), "vkCreateFence");
     if (device_.timestamp_bits() > 0) {
       VkQueryPoolCreateInfo queries{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
       queries.queryType = VK_QUERY_TYPE_TIMESTAMP;
-      queries.queryCount = kTimestamps;
+      queries.queryCount = kTimestamps * kRing;
       device_.check(vkCreateQueryPool(device_.handle(), &queries, nullptr, &timestamps_), "vkCreateQueryPool");
     }
     initialise_constants();
@@ -326,12 +338,19 @@ VulkanNetwork::~VulkanNetwork() { release_handles(); }
 
 void VulkanNetwork::release_handles() {
   VkDevice d = device_.handle();
+  // Steps still running use the buffers and command buffers released below.
+  for (const Started& s : started_) {
+    vkWaitForFences(d, 1, &ring_[static_cast<std::size_t>(s.entry)].fence, VK_TRUE, UINT64_MAX);
+  }
+  started_.clear();
   if (timestamps_ != VK_NULL_HANDLE) vkDestroyQueryPool(d, timestamps_, nullptr);
-  if (fence_ != VK_NULL_HANDLE) vkDestroyFence(d, fence_, nullptr);
+  for (auto& t : ring_) {
+    if (t.fence != VK_NULL_HANDLE) vkDestroyFence(d, t.fence, nullptr);
+    t.fence = VK_NULL_HANDLE;
+  }
   if (pool_ != VK_NULL_HANDLE) vkDestroyCommandPool(d, pool_, nullptr);  // frees its command buffers
   for (VkDescriptorPool p : descriptor_pools_) vkDestroyDescriptorPool(d, p, nullptr);
   timestamps_ = VK_NULL_HANDLE;
-  fence_ = VK_NULL_HANDLE;
   pool_ = VK_NULL_HANDLE;
   descriptor_pools_.clear();
 }
@@ -440,11 +459,12 @@ VkCommandBuffer allocate_commands(VulkanDevice& device, VkCommandPool pool) {
 }
 }  // namespace
 
-const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, const std::function<void(Recorder&)>& record) {
+const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, int entry,
+                                                 const std::function<void(Recorder&)>& record) {
   if (auto it = command_buffers_.find(key); it != command_buffers_.end()) return it->second;
-  Pass pass{allocate_commands(device_, pool_), {}};
+  Pass pass{allocate_commands(device_, pool_), {}, entry};
   try {
-    Recorder r(*this, pass.commands, nullptr, &pass.marks);
+    Recorder r(*this, pass.commands, nullptr, &pass.marks, entry);
     record(r);
     r.end();
   } catch (...) {
@@ -454,15 +474,19 @@ const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, const s
   return command_buffers_.emplace(key, std::move(pass)).first->second;
 }
 
-// Runs a recorded pass and reads its timestamps: each stage's time is the difference to the
-// timestamp before it, on a counter of timestamp_bits() bits that may wrap.
 void VulkanNetwork::run(const Pass& pass) {
-  device_.submit_and_wait(pass.commands, fence_);
+  device_.submit_and_wait(pass.commands, ring_[static_cast<std::size_t>(pass.entry)].fence);
+  read_stage_times(pass);
+}
+
+// Each stage's time is the difference to the timestamp before it, on a counter of
+// timestamp_bits() bits that may wrap.
+void VulkanNetwork::read_stage_times(const Pass& pass) {
   if (pass.marks.empty()) return;
   const auto count = static_cast<uint32_t>(pass.marks.size() + 1);
   timestamp_values_.resize(count);
-  device_.check(vkGetQueryPoolResults(device_.handle(), timestamps_, 0, count, count * sizeof(uint64_t),
-                                      timestamp_values_.data(), sizeof(uint64_t),
+  device_.check(vkGetQueryPoolResults(device_.handle(), timestamps_, static_cast<uint32_t>(pass.entry) * kTimestamps,
+                                      count, count * sizeof(uint64_t), timestamp_values_.data(), sizeof(uint64_t),
                                       VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
                 "vkGetQueryPoolResults");
   const uint32_t bits = device_.timestamp_bits();
@@ -473,34 +497,66 @@ void VulkanNetwork::run(const Pass& pass) {
   }
 }
 
-void VulkanNetwork::encode(const Tensor& image, int slot) {
+void VulkanNetwork::require_idle(const char* call) const {
+  if (!started_.empty()) {
+    throw std::logic_error(std::string("VulkanNetwork::") + call + " while streamed steps are unfinished");
+  }
+}
+
+void VulkanNetwork::fill_upload(const Transfer& t, const Frame* frame, const Tensor* image) {
+  if (frame) {
+    auto* dst = reinterpret_cast<std::uint8_t*>(t.upload.mapped());
+    const std::size_t row = static_cast<std::size_t>(frame->layout.width) * 3;
+    for (int y = 0; y < frame->layout.height; ++y) std::memcpy(dst + y * row, frame->data + y * frame->stride, row);
+    return;
+  }
   // Planar upload: the device layout is [C][H][W].
   const std::size_t hw = static_cast<std::size_t>(height_) * width_;
   staging_.resize(3 * hw);
   float* dst = staging_.data();
   for (std::size_t p = 0; p < hw; ++p) {
-    dst[p] = image.data[3 * p];
-    dst[hw + p] = image.data[3 * p + 1];
-    dst[2 * hw + p] = image.data[3 * p + 2];
+    dst[p] = image->data[3 * p];
+    dst[hw + p] = image->data[3 * p + 1];
+    dst[2 * hw + p] = image->data[3 * p + 2];
   }
-  store(staging_.data(), staging_.size(), upload_.mapped());
-  run(cached("encode" + std::to_string(slot), [&](Recorder& r) { record_encode(r, slot, nullptr); }));
+  store(staging_.data(), staging_.size(), t.upload.mapped());
+}
+
+void VulkanNetwork::read_flow(const Transfer& t, Tensor& out) {
+  out.resize(height_, width_, 2);
+  const std::size_t hw = static_cast<std::size_t>(height_) * width_;
+  staging_.resize(2 * hw);
+  load(t.readback.mapped(), staging_.size(), staging_.data());
+  const float* planar = staging_.data();
+  for (std::size_t p = 0; p < hw; ++p) {
+    out.data[2 * p] = planar[p];
+    out.data[2 * p + 1] = planar[hw + p];
+  }
+}
+
+// One recording per slot and layout: a session's frames keep one size and channel order.
+std::string VulkanNetwork::encode_key(const FrameLayout* layout) {
+  if (!layout) return "f32";
+  return "u8:" + std::to_string(layout->width) + "x" + std::to_string(layout->height) + "+" +
+         std::to_string(layout->pad_left) + "+" + std::to_string(layout->pad_top) + (layout->swap ? ":swap" : "");
+}
+
+void VulkanNetwork::encode(const Tensor& image, int slot) {
+  require_idle("encode");
+  fill_upload(ring_[0], nullptr, &image);
+  run(cached("encode" + std::to_string(slot), 0, [&](Recorder& r) { record_encode(r, slot, nullptr); }));
 }
 
 void VulkanNetwork::encode(const Frame& frame, int slot) {
-  auto* dst = reinterpret_cast<std::uint8_t*>(upload_.mapped());
-  const FrameLayout& layout = frame.layout;
-  const std::size_t row = static_cast<std::size_t>(layout.width) * 3;
-  for (int y = 0; y < layout.height; ++y) std::memcpy(dst + y * row, frame.data + y * frame.stride, row);
-  // One recording per slot and layout: a session's frames keep one size and channel order.
-  const std::string key = "encode_u8:" + std::to_string(slot) + ":" + std::to_string(layout.width) + "x" +
-                          std::to_string(layout.height) + "+" + std::to_string(layout.pad_left) + "+" +
-                          std::to_string(layout.pad_top) + (layout.swap ? ":swap" : "");
-  run(cached(key, [&](Recorder& r) { record_encode(r, slot, &layout); }));
+  require_idle("encode");
+  fill_upload(ring_[0], &frame, nullptr);
+  const std::string key = "encode" + std::to_string(slot) + ":" + encode_key(&frame.layout);
+  run(cached(key, 0, [&](Recorder& r) { record_encode(r, slot, &frame.layout); }));
 }
 
 void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Tensor& out,
                          const StageObserver* observer) {
+  require_idle("flow");
   if (observer && *observer) {
     if (observed_commands_ == VK_NULL_HANDLE) observed_commands_ = allocate_commands(device_, pool_);
     Recorder r(*this, observed_commands_, observer);
@@ -509,18 +565,45 @@ void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Ten
   } else {
     const std::string key = "flow" + std::to_string(slot0) + std::to_string(slot1) + ":" +
                             std::to_string(iterations.s16) + ":" + std::to_string(iterations.s8);
-    run(cached(key, [&](Recorder& r) { record_flow(r, slot0, slot1, iterations); }));
+    run(cached(key, 0, [&](Recorder& r) { record_flow(r, slot0, slot1, iterations); }));
   }
-  out.resize(height_, width_, 2);
-  const std::size_t hw = static_cast<std::size_t>(height_) * width_;
-  staging_.resize(2 * hw);
-  load(readback_.mapped(), staging_.size(), staging_.data());
-  const float* planar = staging_.data();
-  for (std::size_t p = 0; p < hw; ++p) {
-    out.data[2 * p] = planar[p];
-    out.data[2 * p + 1] = planar[hw + p];
-  }
+  read_flow(ring_[0], out);
   if (observer && *observer) (*observer)(StageTensor{"flow", 0, height_, width_, 2, out.data.data()});
+}
+
+void VulkanNetwork::start(const Step& step) {
+  if (started() >= kRing) throw std::logic_error("VulkanNetwork::start: every ring entry is in use");
+  if ((step.frame == nullptr) == (step.image == nullptr)) {
+    throw std::logic_error("VulkanNetwork::start: a step takes a frame or an image");
+  }
+  const int entry = next_entry_;
+  const Transfer& t = ring_[static_cast<std::size_t>(entry)];
+  const FrameLayout* layout = step.frame ? &step.frame->layout : nullptr;
+  const bool pair = step.previous >= 0;
+  std::string key = "step" + std::to_string(entry) + ":" + std::to_string(step.slot) + ":" + encode_key(layout);
+  if (pair) {
+    key += ":flow" + std::to_string(step.previous) + ":" + std::to_string(step.iterations.s16) + ":" +
+           std::to_string(step.iterations.s8);
+  }
+  const Pass& pass = cached(key, entry, [&](Recorder& r) {
+    record_encode(r, step.slot, layout);
+    if (pair) record_flow(r, step.previous, step.slot, step.iterations);
+  });
+  fill_upload(t, step.frame, step.image);  // the entry's last step is finished: nothing reads it
+  device_.submit(pass.commands, t.fence);
+  started_.push_back({entry, &pass, pair});
+  next_entry_ = (entry + 1) % kRing;
+}
+
+bool VulkanNetwork::finish(Tensor& out) {
+  if (started_.empty()) throw std::logic_error("VulkanNetwork::finish: no step started");
+  const Started s = started_.front();
+  started_.pop_front();
+  const Transfer& t = ring_[static_cast<std::size_t>(s.entry)];
+  device_.wait(t.fence);
+  read_stage_times(*s.pass);
+  if (s.pair) read_flow(t, out);
+  return s.pair;
 }
 
 void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* frame) {
@@ -531,10 +614,10 @@ void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* fram
     struct {
       int in_w, in_h, out_w, out_h, pad_left, pad_top, swap;
     } p{frame->width, frame->height, w, h, frame->pad_left, frame->pad_top, frame->swap ? 1 : 0};
-    r.dispatch(Shader::frame_u8, {&upload_, nullptr, &input_, nullptr}, &p, sizeof p,
+    r.dispatch(Shader::frame_u8, {&r.upload(), nullptr, &input_, nullptr}, &p, sizeof p,
                groups(static_cast<long>(h) * w, kLocal));
   } else {
-    r.copy_raw(upload_, input_, static_cast<std::size_t>(3) * h * w);
+    r.copy_raw(r.upload(), input_, static_cast<std::size_t>(3) * h * w);
   }
   r.avgpool(input, half);
   r.avgpool(half, quarter);
@@ -721,7 +804,7 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   } cp{h8_, w8_};
   r.dispatch(Shader::convex_upsample, {&mask_, &flow8_, &flow_full_, nullptr}, &cp, sizeof cp,
              groups(static_cast<long>(height_) * width_, kLocal));
-  r.copy_raw(flow_full_, readback_, static_cast<std::size_t>(2) * height_ * width_);
+  r.copy_raw(flow_full_, r.readback(), static_cast<std::size_t>(2) * height_ * width_);
   r.host_barrier();
   r.mark("flow");
 }

@@ -5,6 +5,13 @@
 // was asked for. With an observer the pass is recorded anew, stopping at every named stage to
 // read it back. Without one, a recorded pass writes a GPU timestamp after each named stage
 // (where the queue has timestamps), so every pass also measures where its time went.
+//
+// Streaming can be pipelined: start() writes a frame into the next entry of a ring of
+// host-visible upload and read-back buffers and queues its encoding and its pair in one
+// submission without waiting, so the host uploads frame N+1 (and reads back pair N-1) while
+// the device computes pair N. The device runs submissions in order (each pass begins with a
+// barrier), so only what the host touches needs a copy per ring entry.
+#include <deque>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -66,6 +73,23 @@ class VulkanNetwork {
   // pass with an observer, or on a queue without timestamps).
   std::vector<StageTime> take_stage_times() { return std::exchange(stage_times_, {}); }
 
+  // Ring entries: passes started and not yet finished.
+  static constexpr int kRing = 2;
+  struct Step {
+    const Frame* frame = nullptr;  // the frame in 8 bits, or
+    const Tensor* image = nullptr;  // converted as encode(Tensor) takes it
+    int slot = 0;                   // where its features go
+    int previous = -1;              // the slot of the frame before it; -1: no pair
+    Iterations iterations;
+  };
+  // Queues the step; std::logic_error when kRing steps are started and not finished. The
+  // synchronous calls above need none outstanding (std::logic_error).
+  void start(const Step& step);
+  // Waits for the oldest started step; its flow into `out` ([height, width, 2]) when it had
+  // a pair (true). The step is finished even when this throws (a lost device).
+  bool finish(Tensor& out);
+  int started() const { return static_cast<int>(started_.size()); }
+
   class Recorder;
 
  private:
@@ -75,12 +99,25 @@ class VulkanNetwork {
   struct Refine {
     Buffer input, constant_in, constant_out, xa, xb, out66;
   };
-  // A recorded pass: the stage after which each of its timestamps 1.. is written (0: its start).
+  // A recorded pass: the stage after which each of its timestamps 1.. is written (0: its start),
+  // in the query range of the ring entry it was recorded for.
   struct Pass {
     VkCommandBuffer commands = VK_NULL_HANDLE;
     std::vector<std::string> marks;
+    int entry = 0;
   };
-  static constexpr uint32_t kTimestamps = 1024;  // per pass; stages past it are not timed
+  // What the host writes and reads while the device works: one per ring entry. The
+  // synchronous calls use entry 0.
+  struct Transfer {
+    Buffer upload, readback;
+    VkFence fence = VK_NULL_HANDLE;
+  };
+  struct Started {
+    int entry;
+    const Pass* pass;
+    bool pair;
+  };
+  static constexpr uint32_t kTimestamps = 1024;  // per ring entry; stages past it are not timed
   // frame: the upload holds an 8-bit frame; nullptr: the upload holds the input as floats.
   void record_encode(Recorder& r, int slot, const FrameLayout* frame);
   void record_flow(Recorder& r, int slot0, int slot1, const Iterations& iterations);
@@ -88,8 +125,14 @@ class VulkanNetwork {
                               const Buffer& out);
   void record_refinement(Recorder& r, const DeviceRefine& w, Refine& buffers, const View& f0, const View& f1,
                          const View& flow, int iterations, const std::string& scale);
-  const Pass& cached(const std::string& key, const std::function<void(Recorder&)>& record);
+  // entry: the ring entry whose buffers and timestamps the pass uses.
+  const Pass& cached(const std::string& key, int entry, const std::function<void(Recorder&)>& record);
   void run(const Pass& pass);
+  void read_stage_times(const Pass& pass);
+  void fill_upload(const Transfer& t, const Frame* frame, const Tensor* image);
+  void read_flow(const Transfer& t, Tensor& out);
+  void require_idle(const char* call) const;
+  static std::string encode_key(const FrameLayout* frame);
   VkDescriptorSet descriptor_set(const std::array<VkBuffer, 4>& buffers);
   void initialise_constants();
   void release_handles();
@@ -103,7 +146,10 @@ class VulkanNetwork {
   std::size_t elem_;   // bytes per stored value: 4 or 2
   int height_, width_, h8_, w8_, h16_, w16_, tokens_, block_rows_;
 
-  Buffer dummy_, zeros_, upload_, readback_;
+  Buffer dummy_, zeros_;
+  std::array<Transfer, kRing> ring_;
+  int next_entry_ = 0;
+  std::deque<Started> started_;
   std::vector<float> staging_;  // host-side frame or read-back, as floats
   Buffer input_, half_, quarter_, eighth_, encode_tmp_, cat8_, cat16_;
   std::array<Slot, kSlots> slots_;
@@ -116,7 +162,6 @@ class VulkanNetwork {
   Buffer upsample_in_, upsample1_, upsample2_, mask_, flow_full_;
 
   VkCommandPool pool_ = VK_NULL_HANDLE;
-  VkFence fence_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorPool> descriptor_pools_;
   std::map<std::array<VkBuffer, 4>, VkDescriptorSet> descriptor_sets_;
   std::map<std::string, Pass> command_buffers_;

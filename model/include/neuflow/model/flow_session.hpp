@@ -49,6 +49,20 @@ class FlowSession {
   std::optional<flow::FlowField> push(const ImageView& frame, const Iterations& iterations);
   void reset();
 
+  // Pipelined streaming, for a caller that has the next frame before it needs the last flow:
+  // submit() does what push() does, but on a backend that overlaps frames (Vulkan: the frame
+  // goes up through a staging ring while the pair before it computes) it returns before the
+  // flow is computed; take() waits for the oldest submitted frame and returns what push() would
+  // have returned for it. At most max_in_flight() frames are submitted and not taken (1 on the
+  // CPU, where submit() computes); submit() beyond that, and push() with frames in flight,
+  // throw std::logic_error. compute(), reset() and a change of frame size keep the frames in
+  // flight (finished first where needed); a failure in take() loses only that frame's flow.
+  void submit(const ImageView& frame);
+  void submit(const ImageView& frame, const Iterations& iterations);
+  std::optional<flow::FlowField> take();
+  int in_flight() const;
+  int max_in_flight() const;
+
   // Sees every intermediate of subsequent passes (for reference comparisons).
   void set_observer(StageObserver observer);
 
@@ -60,7 +74,7 @@ class FlowSession {
   // CPU, or fp16 on a device without it running fp32. Empty otherwise. Callers report it once.
   const std::string& fallback_warning() const;
 
-  // Where the last compute() or push() spent its time on a GPU, measured by the device's own
+  // Where the last compute(), push() or take() spent its time on a GPU, measured by the device's own
   // timestamps (not the host's clock, so without submission and read-back): each stage in the
   // order it ran, the frames' encodings first. Empty on the CPU backend (time its stages with
   // an observer), while an observer is set, and on a device whose queue has no timestamps.
