@@ -133,6 +133,120 @@ TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {
   EXPECT_GT(compare(p01, p12).max, 1e-3) << "different pairs should give different flows";
 }
 
+// Pipelined streaming through the staging ring: two frames in flight give exactly push()'s
+// flows (the same shaders on the same data), also with a pair computed in between, a frame
+// converted on the CPU (a resize) and a change of frame size; the limit is an error, not a
+// wait; a session destroyed with a frame in flight waits for it (the validation layer sees
+// every buffer released after its last use).
+TEST_F(VulkanSession, PipelinedStreamingGivesPushsFlows) {
+  std::vector<cv::Mat> f(4);
+  for (int i = 0; i < 4; ++i) cv::resize(frames_[i % 3], f[i], cv::Size(100, 60), 0, 0, cv::INTER_AREA);
+  cv::flip(f[3], f[3], 1);  // a fourth frame unlike the others
+  const SessionOptions options{.iterations = {1, 2}, .backend = Backend::vulkan};
+  FlowSession reference(model_, options);
+  std::vector<std::optional<flow::FlowField>> expected;
+  for (const auto& m : f) expected.push_back(reference.push(view_of(m)));
+
+  FlowSession pipe(model_, options);
+  EXPECT_EQ(pipe.max_in_flight(), 2);
+  pipe.submit(view_of(f[0]));
+  pipe.submit(view_of(f[1]));
+  EXPECT_EQ(pipe.in_flight(), 2);
+  EXPECT_THROW(pipe.submit(view_of(f[2])), std::logic_error);
+  EXPECT_THROW(pipe.push(view_of(f[2])), std::logic_error);
+  EXPECT_FALSE(pipe.take().has_value()) << "the first frame has no pair";
+  pipe.submit(view_of(f[2]));
+  const auto pair01 = pipe.compute(view_of(f[0]), view_of(f[1]));  // with a frame in flight
+  std::vector<std::optional<flow::FlowField>> got{std::nullopt};
+  got.push_back(pipe.take());
+  pipe.submit(view_of(f[3]));
+  got.push_back(pipe.take());
+  if (list_gpu_devices().at(0).timestamps) {
+    EXPECT_FALSE(pipe.device_stage_times().empty());
+  }
+  got.push_back(pipe.take());
+  EXPECT_EQ(pipe.in_flight(), 0);
+  EXPECT_THROW(pipe.take(), std::logic_error);
+  for (std::size_t i = 1; i < f.size(); ++i) {
+    ASSERT_TRUE(expected[i] && got[i]) << i;
+    EXPECT_EQ(compare(*got[i], *expected[i]).max, 0) << "pair " << i - 1 << "-" << i;
+  }
+  EXPECT_LT(compare(pair01, *expected[1]).max, 1e-5);
+
+  // A new frame size while a frame is in flight: that frame is finished on the old plan.
+  cv::Mat s0, s1;
+  cv::resize(f[0], s0, cv::Size(64, 48));
+  cv::resize(f[1], s1, cv::Size(64, 48));
+  pipe.submit(view_of(f[0]));
+  pipe.submit(view_of(s0));
+  EXPECT_TRUE(pipe.take().has_value()) << "the stream goes on from f[3]";
+  EXPECT_FALSE(pipe.take().has_value()) << "a new size starts the stream anew";
+  pipe.submit(view_of(s1));
+  const auto small = pipe.take();
+  ASSERT_TRUE(small);
+  EXPECT_EQ(small->width, 64);
+  FlowSession small_reference(model_, options);
+  EXPECT_LT(compare(*small, small_reference.compute(view_of(s0), view_of(s1))).max, 1e-5);
+
+  // Resized to the model size on the CPU, then up through the ring as floats.
+  SessionOptions resized = options;
+  resized.model_width = 96;
+  resized.model_height = 64;
+  FlowSession resized_push(model_, resized), resized_pipe(model_, resized);
+  resized_push.push(view_of(f[0]));
+  const auto r01 = resized_push.push(view_of(f[1]));
+  resized_pipe.submit(view_of(f[0]));
+  resized_pipe.submit(view_of(f[1]));
+  resized_pipe.take();
+  const auto p01 = resized_pipe.take();
+  ASSERT_TRUE(r01 && p01);
+  EXPECT_EQ(compare(*p01, *r01).max, 0);
+
+  pipe.submit(view_of(s0));
+  pipe.submit(view_of(s1));  // left in flight: the destructor waits for both
+}
+
+// A device lost while frames are in flight: what is submitted from then on fails naming the
+// device, the frames already in flight are taken or fail the same way (nothing hangs), and a
+// new session streams again.
+TEST_F(VulkanSession, ADeviceLostWhileFramesAreInFlightFailsThemAndANewSessionStreams) {
+  cv::Mat a, b;
+  cv::resize(frames_[0], a, cv::Size(64, 48));
+  cv::resize(frames_[1], b, cv::Size(64, 48));
+  const SessionOptions options{.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0};
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER", "4", 1), 0);
+  int failures = 0;
+  {
+    FlowSession session(model_, options);
+    unsetenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER");
+    for (int i = 0; i < 10; ++i) {
+      try {
+        if (session.in_flight() == session.max_in_flight()) session.take();
+        session.submit(view_of(i % 2 ? b : a));
+      } catch (const BackendError& e) {
+        EXPECT_EQ(e.kind(), BackendError::Kind::device_lost) << e.what();
+        EXPECT_NE(std::string(e.what()).find("vulkan device 0"), std::string::npos) << e.what();
+        ++failures;
+      }
+    }
+    while (session.in_flight() > 0) {
+      try {
+        session.take();
+      } catch (const BackendError&) {
+        ++failures;
+      }
+    }
+  }
+  EXPECT_GT(failures, 0) << "the device was not lost";
+  FlowSession again(model_, options);
+  again.submit(view_of(a));
+  again.submit(view_of(b));
+  EXPECT_FALSE(again.take().has_value());
+  const auto flow = again.take();
+  ASSERT_TRUE(flow);
+  EXPECT_EQ(flow->width, 64);
+}
+
 // In padding mode the device converts the frame from its 8-bit pixels (frame_u8.comp): at an
 // odd offset in its padding, in either channel order, with a row stride longer than the row;
 // a resize is converted on the CPU. Each gives the CPU backend's flow.
