@@ -78,6 +78,25 @@ TEST_F(SessionTest, StreamingGivesTheSameFlowAsPairs) {
   EXPECT_GT(max_abs_diff(p01, p12), 1e-3) << "different pairs should give different flows";
 }
 
+// submit()/take() on the CPU: one frame in flight (submit computes it), the same flows as push().
+TEST_F(SessionTest, SubmitAndTakeGiveThePushedFlowsOneFrameAtATimeOnTheCpu) {
+  FlowSession pushed(model_, {.threads = 2});
+  FlowSession submitted(model_, {.threads = 2});
+  EXPECT_EQ(submitted.max_in_flight(), 1);
+  for (int i = 0; i < 3; ++i) {
+    const auto expected = pushed.push(view_of(frames_[i]));
+    submitted.submit(view_of(frames_[i]));
+    EXPECT_EQ(submitted.in_flight(), 1);
+    EXPECT_THROW(submitted.submit(view_of(frames_[i])), std::logic_error) << "one in flight at most";
+    const auto got = submitted.take();
+    ASSERT_EQ(got.has_value(), expected.has_value()) << i;
+    if (got) {
+      EXPECT_EQ(max_abs_diff(*got, *expected), 0) << i;
+    }
+  }
+  EXPECT_THROW(submitted.take(), std::logic_error) << "nothing in flight";
+}
+
 TEST_F(SessionTest, ResetAndSizeChangeStartANewStream) {
   FlowSession stream(model_, {.threads = 2});
   stream.push(view_of(frames_[0]));
