@@ -390,6 +390,9 @@ void inference_loop(gpointer data) {
            (static_cast<int>(st.in_flight.size()) >= st.session->max_in_flight() || !st.input.frame_waiting())) {
       ret = deliver_oldest(self, st, settings);
     }
+    if (ret == GST_FLOW_OK && !st.in_flight.empty()) {
+      GST_LOG_OBJECT(self, "frame %" G_GUINT64_FORMAT " in flight while the next one goes up", st.in_flight.back().frame);
+    }
   } else {
     while (ret == GST_FLOW_OK && !st.in_flight.empty()) ret = deliver_oldest(self, st, settings);  // events keep their place
   }
