@@ -6,7 +6,9 @@
 // direct run just before. GFLOP/s always counts the direct convolutions' arithmetic.
 //
 // With --backend vulkan the GPU runs the same pairs and streams (`x_cpu`: the CPU's time over
-// the GPU's), and `vulkan_stream_stages` splits a streamed frame by the GPU's timestamps.
+// the GPU's), `vulkan_stream_pipelined` streams with a frame in flight (its `x_push`: the
+// plain stream's time over its own), and `vulkan_stream_stages` splits a streamed frame by the
+// GPU's timestamps.
 //
 //   neuflow-bench-core [--model CKPT] [--threads N] [--sizes 320x256,768x432]
 //                      [--backend cpu|vulkan] [--device N] [benchmark flags]
@@ -162,6 +164,8 @@ void compare(benchmark::State& state, const std::string& key, const Variant& v) 
   }
 }
 
+std::map<std::string, double> g_vulkan_push_ms;  // size → vulkan_stream's ms a frame
+
 void BM_Pair(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));
   if (variant.backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
@@ -200,6 +204,43 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
   report(state, total / static_cast<double>(state.iterations()),
          neuflow::model::network_cost(height, width).stream_frame());
   compare(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), variant);
+  if (variant.backend == neuflow::model::Backend::vulkan) {
+    g_vulkan_push_ms[std::to_string(width) + "x" + std::to_string(height)] = state.counters["ms"];
+  }
+}
+
+// A stream with a frame always in flight (FlowSession::submit/take, the element's way when
+// frames queue): each frame goes up through the staging ring while the pair before it
+// computes. x_push: vulkan_stream's time (push, nothing in flight) over this one's.
+void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant variant) {
+  FlowSession session(g_model, options_for(variant));
+  state.SetLabel(session.backend_description() + ", " + std::to_string(session.max_in_flight()) + " in flight");
+  const FrameSequence frames(width, height);
+  std::size_t i = 0;
+  for (; i < 4; ++i) {  // warm-up: both ring entries' recordings, with and without a pair
+    if (session.in_flight() == session.max_in_flight()) session.take();
+    session.submit(view(frames.at(i)));
+  }
+  while (session.in_flight() > 1) session.take();
+  double total = 0;
+  for (auto _ : state) {
+    const cv::Mat frame = frames.at(i);
+    const auto t0 = std::chrono::steady_clock::now();
+    session.submit(view(frame));  // goes up while the frame before it computes
+    auto f = session.take();      // the frame before it
+    total += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    benchmark::DoNotOptimize(f);
+    ++i;
+  }
+  while (session.in_flight() > 0) session.take();
+  report(state, total / static_cast<double>(state.iterations()),
+         neuflow::model::network_cost(height, width).stream_frame());
+  const std::string key = std::to_string(width) + "x" + std::to_string(height);
+  if (const auto it = g_vulkan_push_ms.find(key); it != g_vulkan_push_ms.end() && state.counters["ms"] > 0) {
+    state.counters["push_ms"] = it->second;
+    state.counters["x_push"] = it->second / state.counters["ms"];
+  }
+  compare(state, "stream/" + key, variant);
 }
 
 // The stages the per-stage benchmarks report (refinement iterations summed per scale).
@@ -368,6 +409,9 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
       benchmark::RegisterBenchmark(("vulkan_stream/" + size).c_str(), BM_Stream, w, h, vulkan)
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(2.0);
+      benchmark::RegisterBenchmark(("vulkan_stream_pipelined/" + size).c_str(), BM_StreamPipelined, w, h, vulkan)
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
     }
