@@ -34,6 +34,7 @@ struct FlowSession::State {
     bool started = false;
     std::optional<flow::FlowField> result;
     FrameGeometry geometry;
+    std::exception_ptr failure;  // finished early and failed: take() throws it
   };
   std::deque<InFlight> in_flight;
 };
@@ -110,26 +111,19 @@ std::optional<flow::FlowField> finished_flow(FlowSession::State& s, const FrameG
   return restore_flow(*flow, g);
 }
 
-// Finishes the frames submitted and still on the backend, keeping their results. One that
-// fails is lost (the others are finished still, so the backend is idle after) and the first
-// failure is thrown.
+// Finishes the frames submitted and still on the backend, keeping their results, so the
+// backend is idle after. One that fails keeps its failure for its own take(): every submit()
+// still matches one take(), and the call that needed the backend idle goes on.
 void finish_started(FlowSession::State& s) {
-  std::exception_ptr failure;
-  for (auto it = s.in_flight.begin(); it != s.in_flight.end();) {
-    if (!it->started) {
-      ++it;
-      continue;
-    }
+  for (auto& f : s.in_flight) {
+    if (!f.started) continue;
+    f.started = false;
     try {
-      it->result = finished_flow(s, it->geometry);
-      it->started = false;
-      ++it;
+      f.result = finished_flow(s, f.geometry);
     } catch (...) {
-      if (!failure) failure = std::current_exception();
-      it = s.in_flight.erase(it);
+      f.failure = std::current_exception();
     }
   }
-  if (failure) std::rethrow_exception(failure);
 }
 
 // Makes the state ready for frames of this size: a new size ends the stream, and a new
@@ -276,8 +270,9 @@ std::optional<flow::FlowField> FlowSession::take() {
   if (s.in_flight.empty()) throw std::logic_error("FlowSession::take: no frame submitted");
   State::InFlight f = std::move(s.in_flight.front());
   s.in_flight.pop_front();
+  s.stage_times.clear();  // a frame finished early (for compute() or a new size) has none
+  if (f.failure) std::rethrow_exception(f.failure);
   if (!f.started) return std::move(f.result);
-  s.stage_times.clear();
   std::optional<flow::FlowField> result = finished_flow(s, f.geometry);
   keep_stage_times(s);
   return result;

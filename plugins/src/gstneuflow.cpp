@@ -25,6 +25,7 @@
 #include <gst/gst.h>
 #include <gst/video/video.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -152,6 +153,7 @@ struct State {
     std::chrono::steady_clock::time_point submitted;
   };
   std::deque<InFlight> in_flight;
+  std::chrono::steady_clock::time_point last_delivered{};
 };
 
 }  // namespace
@@ -317,9 +319,11 @@ GstFlowReturn deliver_oldest(GstNeuflow *self, State &st, const Settings &settin
     GST_ELEMENT_ERROR(self, STREAM, FAILED, ("optical flow failed: %s", e.what()), (nullptr));
     return GST_FLOW_ERROR;
   }
-  // With a frame in flight this spans the time that frame waited for the one before it: the
-  // latency a frame sees.
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - f.submitted).count();
+  // The frame's own computation: from its submission, or from the delivery of the frame before
+  // it where it was queued behind that one (the latency query adds the wait for that frame).
+  const auto now = std::chrono::steady_clock::now();
+  const double seconds = std::chrono::duration<double>(now - std::max(f.submitted, st.last_delivered)).count();
+  st.last_delivered = now;
   // backend=auto can leave the GPU at the first frame (its plan does not fit): say so once.
   if (st.session->fallback_warning() != st.reported_fallback) {
     st.reported_fallback = st.session->fallback_warning();

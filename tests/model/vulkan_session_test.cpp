@@ -161,10 +161,11 @@ TEST_F(VulkanSession, PipelinedStreamingGivesPushsFlows) {
   got.push_back(pipe.take());
   pipe.submit(view_of(f[3]));
   got.push_back(pipe.take());
-  if (list_gpu_devices().at(0).timestamps) {
-    EXPECT_FALSE(pipe.device_stage_times().empty());
-  }
+  EXPECT_TRUE(pipe.device_stage_times().empty()) << "finished early by compute(): its times are not kept";
   got.push_back(pipe.take());
+  if (list_gpu_devices().at(0).timestamps) {
+    EXPECT_FALSE(pipe.device_stage_times().empty()) << "the device's times of the frame just taken";
+  }
   EXPECT_EQ(pipe.in_flight(), 0);
   EXPECT_THROW(pipe.take(), std::logic_error);
   for (std::size_t i = 1; i < f.size(); ++i) {
@@ -206,38 +207,54 @@ TEST_F(VulkanSession, PipelinedStreamingGivesPushsFlows) {
   pipe.submit(view_of(s1));  // left in flight: the destructor waits for both
 }
 
-// A device lost while frames are in flight: what is submitted from then on fails naming the
-// device, the frames already in flight are taken or fail the same way (nothing hangs), and a
-// new session streams again.
-TEST_F(VulkanSession, ADeviceLostWhileFramesAreInFlightFailsThemAndANewSessionStreams) {
+// A device lost while a frame is in flight: the submission that finds it lost fails naming
+// the device; the frame in flight fails from its own take(), also after compute() finished it
+// early (so each submit() still has one take()); a new session streams again.
+TEST_F(VulkanSession, ADeviceLostWhileAFrameIsInFlightFailsItAndANewSessionStreams) {
   cv::Mat a, b;
   cv::resize(frames_[0], a, cv::Size(64, 48));
   cv::resize(frames_[1], b, cv::Size(64, 48));
   const SessionOptions options{.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0};
-  ASSERT_EQ(setenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER", "4", 1), 0);
-  int failures = 0;
+  const auto expect_lost = [](const BackendError& e) {
+    EXPECT_EQ(e.kind(), BackendError::Kind::device_lost) << e.what();
+    EXPECT_NE(std::string(e.what()).find("vulkan device 0"), std::string::npos) << e.what();
+  };
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER", "6", 1), 0);
   {
     FlowSession session(model_, options);
     unsetenv("NEUFLOW_VULKAN_LOSE_DEVICE_AFTER");
-    for (int i = 0; i < 10; ++i) {
+    bool lost = false;
+    int taken = 0;
+    for (int i = 0; i < 12 && !lost; ++i) {
+      if (session.in_flight() == session.max_in_flight()) {
+        session.take();  // finished before the loss
+        ++taken;
+      }
       try {
-        if (session.in_flight() == session.max_in_flight()) session.take();
         session.submit(view_of(i % 2 ? b : a));
       } catch (const BackendError& e) {
-        EXPECT_EQ(e.kind(), BackendError::Kind::device_lost) << e.what();
-        EXPECT_NE(std::string(e.what()).find("vulkan device 0"), std::string::npos) << e.what();
-        ++failures;
+        expect_lost(e);
+        lost = true;
       }
     }
-    while (session.in_flight() > 0) {
-      try {
-        session.take();
-      } catch (const BackendError&) {
-        ++failures;
-      }
+    ASSERT_TRUE(lost) << "the device was not lost in 12 frames";
+    EXPECT_GT(taken, 0) << "frames streamed before the loss";
+    ASSERT_EQ(session.in_flight(), 1) << "the frame before the failed submission is in flight";
+    try {
+      session.compute(view_of(a), view_of(b));  // finishes the frame in flight first
+      ADD_FAILURE() << "computed on a lost device";
+    } catch (const BackendError& e) {
+      expect_lost(e);
     }
+    EXPECT_EQ(session.in_flight(), 1) << "its failure waits for its take()";
+    try {
+      session.take();
+      ADD_FAILURE() << "a frame in flight when the device was lost gave a flow";
+    } catch (const BackendError& e) {
+      expect_lost(e);
+    }
+    EXPECT_EQ(session.in_flight(), 0);
   }
-  EXPECT_GT(failures, 0) << "the device was not lost";
   FlowSession again(model_, options);
   again.submit(view_of(a));
   again.submit(view_of(b));

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -452,6 +453,16 @@ TEST_F(NeuflowElement, VulkanBackendWritesTheSameFlowsAsTheCpu) {
   unsetenv("NEUFLOW_VULKAN_VALIDATION");
 }
 
+// Counts the element's log lines saying a frame stays in flight while the next one uploads.
+void count_in_flight(GstDebugCategory* category, GstDebugLevel, const gchar*, const gchar*, gint, GObject*,
+                     GstDebugMessage* message, gpointer counter) {
+  if (std::string(gst_debug_category_get_name(category)) != "neuflow") return;
+  const gchar* text = gst_debug_message_get(message);
+  if (text && std::string(text).find("in flight while the next one goes up") != std::string::npos) {
+    ++*static_cast<std::atomic<int>*>(counter);
+  }
+}
+
 // backend=vulkan with frames queued (every-pair): the element keeps a frame in flight while
 // the next one uploads, and still delivers every frame in order with the pair it closes and
 // the CPU's flow; a flush with frames in flight drops them and the stream starts anew; the
@@ -459,6 +470,9 @@ TEST_F(NeuflowElement, VulkanBackendWritesTheSameFlowsAsTheCpu) {
 TEST_F(NeuflowElement, VulkanFramesInFlightArriveInOrderWithTheirPairs) {
   NEUFLOW_REQUIRE_VULKAN();
   ASSERT_EQ(setenv("NEUFLOW_VULKAN_VALIDATION", "fatal", 1), 0);
+  std::atomic<int> kept_in_flight{0};
+  gst_debug_set_threshold_for_name("neuflow", GST_LEVEL_LOG);
+  gst_debug_add_log_function(count_in_flight, &kept_in_flight, nullptr);
   GstHarness* h = harness("backend=vulkan device=0 iters-s8=2");
   gst_harness_set_src_caps_str(h, caps_for(64, 48).c_str());
   constexpr int kFrames = 6;
@@ -490,6 +504,8 @@ TEST_F(NeuflowElement, VulkanFramesInFlightArriveInOrderWithTheirPairs) {
     }
     gst_buffer_unref(out);
   }
+  // Six frames pushed at once while each takes a second or more on lavapipe: they queued.
+  EXPECT_GT(kept_in_flight.load(), 0) << "no frame was kept in flight while the next one went up";
 
   // Frames queued and in flight when a flush comes: dropped, and the stream of flows restarts.
   for (int i = 0; i < 3; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (10 + i) * GST_SECOND)), GST_FLOW_OK);
@@ -517,6 +533,8 @@ TEST_F(NeuflowElement, VulkanFramesInFlightArriveInOrderWithTheirPairs) {
 
   for (int i = 0; i < 3; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (200 + i) * GST_SECOND)), GST_FLOW_OK);
   gst_harness_teardown(h);  // with frames queued and in flight
+  gst_debug_remove_log_function(count_in_flight);
+  gst_debug_unset_threshold_for_name("neuflow");
   unsetenv("NEUFLOW_VULKAN_VALIDATION");
 }
 

@@ -331,6 +331,9 @@ void VulkanDevice::submit(VkCommandBuffer commands, VkFence fence) {
 void VulkanDevice::wait(VkFence fence) {
   VkResult r = vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX);
   if (r == VK_SUCCESS) r = vkResetFences(device_, 1, &fence);
+  // Work that was in flight when the device was lost (at a later submission, or as
+  // NEUFLOW_VULKAN_LOSE_DEVICE_AFTER makes it) has no result to trust either.
+  if (r == VK_SUCCESS && lost_) r = VK_ERROR_DEVICE_LOST;
   if (r == VK_ERROR_DEVICE_LOST) lost_ = true;
   check(r, "running the network (vkWaitForFences)");
 }

@@ -56,7 +56,8 @@ class FlowSession {
   // have returned for it. At most max_in_flight() frames are submitted and not taken (1 on the
   // CPU, where submit() computes); submit() beyond that, and push() with frames in flight,
   // throw std::logic_error. compute(), reset() and a change of frame size keep the frames in
-  // flight (finished first where needed); a failure in take() loses only that frame's flow.
+  // flight (finished first where needed). A frame whose computation fails (a lost device)
+  // throws from its own take(), also when it was finished early: each submit() has one take().
   void submit(const ImageView& frame);
   void submit(const ImageView& frame, const Iterations& iterations);
   std::optional<flow::FlowField> take();
