@@ -390,9 +390,10 @@ class DaemonVideoOut(DaemonTestCase):
         d.wait_log(r"rtsp: 1 user from .*rtsp-users \(digest authentication\)", timeout=10)
 
         def watch(*login):
-            return subprocess.run([os.environ["GST_LAUNCH"], "-q", "rtspsrc", f"location=rtsp://127.0.0.1:{rtsp_port}/cam",
+            return subprocess.run([os.environ["GST_LAUNCH"], "rtspsrc", f"location=rtsp://127.0.0.1:{rtsp_port}/cam",
                                    *login, "!", "rtph264depay", "!", "avdec_h264", "!", "fakesink", "num-buffers=3"],
-                                  capture_output=True, text=True, timeout=60, env=plain_gst_env())
+                                  capture_output=True, text=True, timeout=60,
+                                  env={**plain_gst_env(), "LC_ALL": "C"})  # gst-launch's messages untranslated
 
         anonymous = watch()
         self.assertNotEqual(anonymous.returncode, 0, "an anonymous client could watch")
@@ -400,7 +401,11 @@ class DaemonVideoOut(DaemonTestCase):
         wrong = watch("user-id=viewer", "user-pw=guess")
         self.assertNotEqual(wrong.returncode, 0, "a wrong password could watch")
         right = watch("user-id=viewer", "user-pw=s3cret")
-        self.assertEqual(right.returncode, 0, right.stderr[-2000:])
+        # "Got EOS" means the frames were decoded with no error before them. As in the test
+        # above, rtspsrc's PAUSE after that EOS can meet the closed connection and gst-launch
+        # then exits 1 (seen here in a full ASan run of the suite): not a failure to watch.
+        self.assertIn("Got EOS from element", right.stdout, (right.stdout + right.stderr)[-2000:])
+        self.assertNotIn("Unauthorized", right.stdout + right.stderr)
         self.assertNotIn("WITHOUT authentication", d.log_text())
         self.assertEqual(d.stop(), 0)
 
