@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <deque>
 #include <exception>
-#include <string>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "frame_geometry.hpp"
@@ -202,23 +202,18 @@ namespace {
 // still reads: the device runs them in order.
 int next_stream_slot(const FlowSession::State& s) { return s.previous_slot == 0 ? 1 : 0; }
 
-}  // namespace
-
-std::optional<flow::FlowField> FlowSession::push(const ImageView& frame) { return push(frame, options_.iterations); }
-
-std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const Iterations& iterations) {
-  if (!state_->in_flight.empty()) {
-    throw std::logic_error("FlowSession::push with submitted frames not yet taken: take() them first");
-  }
+// One frame of a stream, computed now: push()'s work, without its check for frames in flight.
+std::optional<flow::FlowField> stream_now(FlowSession::State& s, const FlowModel& model,
+                                          const SessionOptions& options, const ImageView& frame,
+                                          const Iterations& iterations) {
   validate(iterations);
-  apply_threads(options_.threads);
-  auto& s = *state_;
-  const FrameGeometry& g = prepare_plan(s, *model_, options_, frame.width, frame.height);
+  apply_threads(options.threads);
+  const FrameGeometry& g = prepare_plan(s, model, options, frame.width, frame.height);
   s.stage_times.clear();
   s.backend->take_stage_times();
   const int current = next_stream_slot(s);
   check_image(frame, g);
-  encode(s, frame, g, options_.network_order, current);
+  encode(s, frame, g, options.network_order, current);
   std::optional<flow::FlowField> result;
   if (s.has_previous) {
     result = restore_flow(s.backend->flow(s.previous_slot, current, iterations, &s.observer), g);
@@ -227,6 +222,17 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   s.previous_slot = current;
   s.has_previous = true;
   return result;
+}
+
+}  // namespace
+
+std::optional<flow::FlowField> FlowSession::push(const ImageView& frame) { return push(frame, options_.iterations); }
+
+std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const Iterations& iterations) {
+  if (!state_->in_flight.empty()) {
+    throw std::logic_error("FlowSession::push with submitted frames not yet taken: take() them first");
+  }
+  return stream_now(*state_, *model_, options_, frame, iterations);
 }
 
 void FlowSession::submit(const ImageView& frame) { submit(frame, options_.iterations); }
@@ -242,19 +248,9 @@ void FlowSession::submit(const ImageView& frame, const Iterations& iterations) {
   const FrameGeometry& g = prepare_plan(s, *model_, options_, frame.width, frame.height);
   check_image(frame, g);
   if (s.backend->stream_depth() == 0 || s.observer) {
-    // Computed now: through push(), once the frames before it are finished (kept in order).
+    // Computed now, once the frames before it are finished (their results keep their order).
     finish_started(s);
-    std::deque<State::InFlight> earlier;
-    std::swap(earlier, s.in_flight);
-    std::optional<flow::FlowField> result;
-    try {
-      result = push(frame, iterations);
-    } catch (...) {
-      std::swap(earlier, s.in_flight);
-      throw;
-    }
-    std::swap(earlier, s.in_flight);
-    s.in_flight.push_back({false, std::move(result), g});
+    s.in_flight.push_back({false, stream_now(s, *model_, options_, frame, iterations), g, nullptr});
     return;
   }
   s.backend->take_stage_times();

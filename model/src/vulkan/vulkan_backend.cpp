@@ -22,10 +22,7 @@ class VulkanBackend final : public InferenceBackend {
   // Padding mode on the device; a resize (OpenCV's fixed-point bilinear) stays on the CPU.
   bool encode_frame(const ImageView& image, const FrameGeometry& g, ChannelOrder network_order, int slot) override {
     if (g.resize) return false;
-    network_.encode(vulkan::VulkanNetwork::Frame{image.data, image.stride,
-                                                 {image.width, image.height, g.pad_left, g.pad_top,
-                                                  image.order != network_order}},
-                    slot);
+    network_.encode(device_frame(image, g, network_order), slot);
     return true;
   }
   const Tensor& flow(int slot0, int slot1, const Iterations& iterations, const StageObserver* observer) override {
@@ -41,12 +38,9 @@ class VulkanBackend final : public InferenceBackend {
     s.slot = step.slot;
     s.previous = step.previous;
     s.iterations = step.iterations;
-    const ImageView& image = step.frame;
-    const vulkan::VulkanNetwork::Frame frame{image.data, image.stride,
-                                             {image.width, image.height, step.geometry.pad_left, step.geometry.pad_top,
-                                              image.order != step.network_order}};
+    const vulkan::VulkanNetwork::Frame frame = device_frame(step.frame, step.geometry, step.network_order);
     if (step.geometry.resize) {  // as in encode_frame(): the resize stays on the CPU
-      prepare_input(image, step.geometry, step.network_order, converted_);
+      prepare_input(step.frame, step.geometry, step.network_order, converted_);
       s.image = &converted_;
     } else {
       s.frame = &frame;
@@ -56,6 +50,13 @@ class VulkanBackend final : public InferenceBackend {
   const Tensor* finish() override { return network_.finish(flow_) ? &flow_ : nullptr; }
 
  private:
+  // The 8-bit frame as the device converts it in padding mode.
+  static vulkan::VulkanNetwork::Frame device_frame(const ImageView& image, const FrameGeometry& g,
+                                                   ChannelOrder network_order) {
+    return {image.data, image.stride,
+            {image.width, image.height, g.pad_left, g.pad_top, image.order != network_order}};
+  }
+
   std::shared_ptr<VulkanContext> context_;
   vulkan::VulkanNetwork network_;
   Tensor flow_;       // the last pair's, read back from the device
