@@ -209,7 +209,8 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
   }
 }
 
-// A stream with a frame always in flight (FlowSession::submit/take): each frame goes up through the staging ring while the pair before it
+// A stream with a frame always in flight (FlowSession::submit/take, the element's way when
+// frames queue): each frame goes up through the staging ring while the pair before it
 // computes. x_push: vulkan_stream's time (push, nothing in flight) over this one's.
 void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));

@@ -90,6 +90,12 @@ class FrameHandoff {
     return entry;
   }
 
+  // Whether the consumer's next entry is a frame that is already waiting (never waits).
+  bool frame_waiting() const {
+    const std::lock_guard lock(mutex_);
+    return !flushing_ && !entries_.empty() && entries_.front().frame;
+  }
+
   void done() {
     {
       const std::lock_guard lock(mutex_);

@@ -25,8 +25,10 @@
 #include <gst/gst.h>
 #include <gst/video/video.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -141,6 +143,17 @@ struct State {
   GstClockTime previous_pts = GST_CLOCK_TIME_NONE;
   guint64 previous_frame = 0;
   std::string reported_fallback;  // the session's fallback warning, once posted
+  // Frames submitted to the session and not yet taken, oldest first (FlowSession::submit: on
+  // a GPU the next frame's upload overlaps the pair before it). Each holds its buffer.
+  struct InFlight {
+    GstBuffer *buffer;
+    guint64 frame;
+    GstClockTime previous_pts;  // the pair it closes, as it was when submitted
+    guint64 previous_frame;
+    std::chrono::steady_clock::time_point submitted;
+  };
+  std::deque<InFlight> in_flight;
+  std::chrono::steady_clock::time_point last_delivered{};
 };
 
 }  // namespace
@@ -263,10 +276,9 @@ bool set_format(GstNeuflow *self, State &st, GstCaps *caps) {
   return true;
 }
 
-// Computes the flow into the frame; on success `*result` is the buffer to push (with its flow
-// meta, except for the first frame of a stream).
-GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guint64 frame_number,
-                            const Settings &settings, GstBuffer **result) {
+// Hands the frame to the session (which may return before its flow is computed) and keeps
+// its buffer in `in_flight` until deliver_oldest() takes the flow.
+GstFlowReturn submit_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guint64 frame_number) {
   if (!st.have_info) {
     gst_buffer_unref(buffer);
     GST_ELEMENT_ERROR(self, CORE, NEGOTIATION, (nullptr), ("a frame arrived before its caps"));
@@ -279,9 +291,8 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
     return GST_FLOW_ERROR;
   }
   const auto started = std::chrono::steady_clock::now();
-  std::optional<neuflow::flow::FlowField> flow;
   try {
-    flow = st.session->push(st.converter.view(frame));
+    st.session->submit(st.converter.view(frame));  // the pixels are copied (or used) before it returns
   } catch (const std::exception &e) {
     gst_video_frame_unmap(&frame);
     gst_buffer_unref(buffer);
@@ -289,7 +300,30 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
     return GST_FLOW_ERROR;
   }
   gst_video_frame_unmap(&frame);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  st.in_flight.push_back({buffer, frame_number, st.previous_pts, st.previous_frame, started});
+  st.previous_pts = GST_BUFFER_PTS(buffer);
+  st.previous_frame = frame_number;
+  return GST_FLOW_OK;
+}
+
+// Takes the oldest frame's flow from the session and queues the frame (with its flow meta,
+// except for the first frame of a stream) for the push thread.
+GstFlowReturn deliver_oldest(GstNeuflow *self, State &st, const Settings &settings) {
+  State::InFlight f = st.in_flight.front();
+  st.in_flight.pop_front();
+  std::optional<neuflow::flow::FlowField> flow;
+  try {
+    flow = st.session->take();
+  } catch (const std::exception &e) {
+    gst_buffer_unref(f.buffer);
+    GST_ELEMENT_ERROR(self, STREAM, FAILED, ("optical flow failed: %s", e.what()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  // The frame's own computation: from its submission, or from the delivery of the frame before
+  // it where it was queued behind that one (the latency query adds the wait for that frame).
+  const auto now = std::chrono::steady_clock::now();
+  const double seconds = std::chrono::duration<double>(now - std::max(f.submitted, st.last_delivered)).count();
+  st.last_delivered = now;
   // backend=auto can leave the GPU at the first frame (its plan does not fit): say so once.
   if (st.session->fallback_warning() != st.reported_fallback) {
     st.reported_fallback = st.session->fallback_warning();
@@ -299,13 +333,11 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
     GST_OBJECT_UNLOCK(self);
   }
 
-  const GstClockTime pts = GST_BUFFER_PTS(buffer);
+  GstBuffer *buffer = f.buffer;
   if (flow) {
-    buffer = neuflow::gst::attach_flow(buffer, *flow, {st.previous_pts, pts, st.previous_frame, frame_number},
+    buffer = neuflow::gst::attach_flow(buffer, *flow, {f.previous_pts, GST_BUFFER_PTS(buffer), f.previous_frame, f.frame},
                                        st.session->options(), seconds);
   }
-  st.previous_pts = pts;
-  st.previous_frame = frame_number;
 
   bool post = false, announce = false;
   neuflow::gst::FlowStats snapshot;
@@ -319,8 +351,26 @@ GstFlowReturn process_frame(GstNeuflow *self, State &st, GstBuffer *buffer, guin
   }
   if (post) post_stats(self, snapshot);
   if (announce) gst_element_post_message(GST_ELEMENT(self), gst_message_new_latency(GST_OBJECT(self)));
-  *result = buffer;
+  Item out{buffer, nullptr, f.frame};
+  // Waits while the push thread is still busy with a result: a slow downstream slows us.
+  if (st.output.push_frame(out, Handoff::Policy::back_pressure) != Handoff::Result::queued) {
+    gst_buffer_unref(buffer);  // flushing, or downstream failed: nobody takes it
+  }
   return GST_FLOW_OK;
+}
+
+// Drops the frames in flight (a flush, a stop, a failure): their flows are taken and thrown
+// away, so the session is idle and every buffer released.
+void discard_in_flight(State &st) {
+  for (auto &f : st.in_flight) {
+    try {
+      st.session->take();
+    } catch (const std::exception &) {
+      // the frame is dropped either way; a failed device says so at the next frame
+    }
+    gst_buffer_unref(f.buffer);
+  }
+  st.in_flight.clear();
 }
 
 // The inference worker: one item of `input` per iteration, its result into `output`.
@@ -329,22 +379,30 @@ void inference_loop(gpointer data) {
   State &st = *self->state;
   auto entry = st.input.take();
   if (!entry) {  // flushing: a flush or a stop pauses or stops this task
+    discard_in_flight(st);
     gst_task_pause(st.inference);
     return;
   }
   Item item = entry->value;
   GstFlowReturn ret = GST_FLOW_OK;
+  const Settings settings = copy_settings(self);
   if (item.buffer) {
-    GstBuffer *result = nullptr;
-    ret = process_frame(self, st, item.buffer, item.frame, copy_settings(self), &result);
-    if (ret == GST_FLOW_OK) {
-      Item out{result, nullptr, item.frame};
-      // Waits while the push thread is still busy with a result: a slow downstream slows us.
-      if (st.output.push_frame(out, Handoff::Policy::back_pressure) != Handoff::Result::queued) {
-        gst_buffer_unref(result);  // flushing, or downstream failed: nobody takes it
-      }
+    ret = submit_frame(self, st, item.buffer, item.frame);
+    // A frame stays in flight only while the next one is already waiting to overlap with it;
+    // otherwise its flow is delivered now, so pipelining never adds latency to a live stream.
+    while (ret == GST_FLOW_OK && !st.in_flight.empty() &&
+           (static_cast<int>(st.in_flight.size()) >= st.session->max_in_flight() || !st.input.frame_waiting())) {
+      ret = deliver_oldest(self, st, settings);
+    }
+    if (ret == GST_FLOW_OK && !st.in_flight.empty()) {
+      GST_LOG_OBJECT(self, "frame %" G_GUINT64_FORMAT " in flight while the next one goes up", st.in_flight.back().frame);
     }
   } else {
+    while (ret == GST_FLOW_OK && !st.in_flight.empty()) ret = deliver_oldest(self, st, settings);  // events keep their place
+  }
+  if (!item.buffer && ret != GST_FLOW_OK) {
+    gst_event_unref(item.event);
+  } else if (!item.buffer) {
     if (GST_EVENT_TYPE(item.event) == GST_EVENT_CAPS) {
       GstCaps *caps = nullptr;
       gst_event_parse_caps(item.event, &caps);
@@ -362,6 +420,7 @@ void inference_loop(gpointer data) {
     // frame, downstream gets an end of stream after what was computed before. Recorded before
     // done(), so that a drain waiting on `input` sees the failure, not an idle worker.
     GST_DEBUG_OBJECT(self, "pausing inference: %s", gst_flow_get_name(ret));
+    discard_in_flight(st);
     st.input.fail(ret);
     Item eos{nullptr, gst_event_new_eos(), 0};
     if (st.output.push_other(eos) != Handoff::Result::queued) gst_event_unref(eos.event);
@@ -499,7 +558,10 @@ gboolean sink_event(GstPad *pad, GstObject *parent, GstEvent *event) {
       // Both threads are paused and nothing was queued since: the worker-only state is ours.
       st.input.stop_flushing();
       st.output.stop_flushing();
-      if (st.session) st.session->reset();
+      if (st.session) {
+        discard_in_flight(st);  // what the worker had in flight when it paused
+        st.session->reset();
+      }
       st.previous_pts = GST_CLOCK_TIME_NONE;
       const gboolean ok = gst_pad_push_event(self->srcpad, event);
       gst_pad_start_task(self->srcpad, push_loop, self, nullptr);
@@ -659,6 +721,7 @@ GstStateChangeReturn change_state(GstElement *element, GstStateChange transition
 
   switch (transition) {
     case GST_STATE_CHANGE_PAUSED_TO_READY:  // pads are deactivated: the worker has stopped
+      if (st.session) discard_in_flight(st);
       st.session.reset();
       st.have_info = false;
       break;

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -449,6 +450,91 @@ TEST_F(NeuflowElement, VulkanBackendWritesTheSameFlowsAsTheCpu) {
     ++compared;
   }
   EXPECT_EQ(compared, 2);
+  unsetenv("NEUFLOW_VULKAN_VALIDATION");
+}
+
+// Counts the element's log lines saying a frame stays in flight while the next one uploads.
+void count_in_flight(GstDebugCategory* category, GstDebugLevel, const gchar*, const gchar*, gint, GObject*,
+                     GstDebugMessage* message, gpointer counter) {
+  if (std::string(gst_debug_category_get_name(category)) != "neuflow") return;
+  const gchar* text = gst_debug_message_get(message);
+  if (text && std::string(text).find("in flight while the next one goes up") != std::string::npos) {
+    ++*static_cast<std::atomic<int>*>(counter);
+  }
+}
+
+// backend=vulkan with frames queued (every-pair): the element keeps a frame in flight while
+// the next one uploads, and still delivers every frame in order with the pair it closes and
+// the CPU's flow; a flush with frames in flight drops them and the stream starts anew; the
+// element is torn down with frames in flight.
+TEST_F(NeuflowElement, VulkanFramesInFlightArriveInOrderWithTheirPairs) {
+  NEUFLOW_REQUIRE_VULKAN();
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_VALIDATION", "fatal", 1), 0);
+  std::atomic<int> kept_in_flight{0};
+  gst_debug_set_threshold_for_name("neuflow", GST_LEVEL_LOG);
+  gst_debug_add_log_function(count_in_flight, &kept_in_flight, nullptr);
+  GstHarness* h = harness("backend=vulkan device=0 iters-s8=2");
+  gst_harness_set_src_caps_str(h, caps_for(64, 48).c_str());
+  constexpr int kFrames = 6;
+  std::vector<cv::Mat> frames;
+  for (int i = 0; i < kFrames; ++i) {
+    frames.push_back(synthetic_frame(64, 48, 2 * i + (i % 2) * 5));
+    ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames.back(), i * GST_SECOND / 30)), GST_FLOW_OK);
+  }
+  neuflow::model::FlowSession cpu(neuflow::model::FlowModel::load(model_),
+                                  {.iterations = {1, 2}, .threads = 2, .backend = neuflow::model::Backend::cpu});
+  for (int i = 0; i < kFrames; ++i) {
+    GstBuffer* out = gst_harness_pull(h);
+    ASSERT_NE(out, nullptr) << i;
+    EXPECT_EQ(GST_BUFFER_PTS(out), static_cast<GstClockTime>(i * GST_SECOND / 30)) << "in order";
+    const auto expected =
+        cpu.push(neuflow::model::ImageView{frames[i].data, 64, 48, 64 * 3, neuflow::model::ChannelOrder::rgb});
+    NeuflowFlowMeta* meta = neuflow_buffer_get_flow_meta(out);
+    ASSERT_EQ(meta != nullptr, expected.has_value()) << i;
+    if (meta) {
+      EXPECT_EQ(meta->from_frame, static_cast<guint64>(i - 1));
+      EXPECT_EQ(meta->to_frame, static_cast<guint64>(i));
+      EXPECT_EQ(meta->from_pts, static_cast<GstClockTime>((i - 1) * GST_SECOND / 30));
+      const gfloat* got = neuflow_flow_meta_get_vectors(meta);
+      double max_err = 0;
+      for (std::size_t k = 0; k < expected->uv.size(); ++k) {
+        max_err = std::max(max_err, static_cast<double>(std::fabs(got[k] - expected->uv[k])));
+      }
+      EXPECT_LT(max_err, 1e-2) << "frame " << i;
+    }
+    gst_buffer_unref(out);
+  }
+  // Six frames pushed at once while each takes a second or more on lavapipe: they queued.
+  EXPECT_GT(kept_in_flight.load(), 0) << "no frame was kept in flight while the next one went up";
+
+  // Frames queued and in flight when a flush comes: dropped, and the stream of flows restarts.
+  for (int i = 0; i < 3; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (10 + i) * GST_SECOND)), GST_FLOW_OK);
+  ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_flush_start()));
+  ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_flush_stop(TRUE)));
+  GstSegment segment;
+  gst_segment_init(&segment, GST_FORMAT_TIME);
+  ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_segment(&segment)));
+  for (int i = 0; i < 2; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (100 + i) * GST_SECOND)), GST_FLOW_OK);
+  std::vector<GstBuffer*> after;
+  while (after.size() < 2) {
+    GstBuffer* out = gst_harness_pull(h);
+    ASSERT_NE(out, nullptr) << "a frame pushed after the flush never came out";
+    if (GST_BUFFER_PTS(out) >= 100 * GST_SECOND) {
+      after.push_back(out);
+    } else {
+      gst_buffer_unref(out);  // delivered before the flush reached the element
+    }
+  }
+  EXPECT_EQ(neuflow_buffer_get_flow_meta(after[0]), nullptr) << "the first frame after a flush has no pair";
+  NeuflowFlowMeta* meta = neuflow_buffer_get_flow_meta(after[1]);
+  ASSERT_NE(meta, nullptr);
+  EXPECT_EQ(meta->from_pts, 100 * GST_SECOND);
+  for (GstBuffer* b : after) gst_buffer_unref(b);
+
+  for (int i = 0; i < 3; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (200 + i) * GST_SECOND)), GST_FLOW_OK);
+  gst_harness_teardown(h);  // with frames queued and in flight
+  gst_debug_remove_log_function(count_in_flight);
+  gst_debug_unset_threshold_for_name("neuflow");
   unsetenv("NEUFLOW_VULKAN_VALIDATION");
 }
 
