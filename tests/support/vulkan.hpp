@@ -16,6 +16,22 @@ inline bool vulkan_required() {
   return env != nullptr && *env != '\0' && std::string(env) != "0";
 }
 
+// Non-empty when this process runs LeakSanitizer with its slow unwinder (what the GStreamer
+// tests' suppressions need): lavapipe's LLVM JIT registers its code's unwind tables under
+// libgcc's lock and allocates while holding it, and LSan's unwind of that allocation waits for
+// the same lock, so a Vulkan test there hangs until ctest's timeout. Failing at once says which
+// list the test belongs in instead.
+inline std::string vulkan_deadlocks_under_lsan() {
+  const char* lsan = std::getenv("LSAN_OPTIONS");
+  const char* asan = std::getenv("ASAN_OPTIONS");
+  const bool slow_unwinder = lsan != nullptr && std::string(lsan).find("fast_unwind_on_malloc=0") != std::string::npos;
+  const bool leaks_checked = asan == nullptr || std::string(asan).find("detect_leaks=0") == std::string::npos;
+  if (!slow_unwinder || !leaks_checked) return {};
+  return "this Vulkan test runs under LeakSanitizer's slow unwinder (LSAN_OPTIONS=...fast_unwind_on_malloc=0), "
+         "which deadlocks against lavapipe's JIT: run it with ASAN_OPTIONS=detect_leaks=0, as "
+         "tests/plugins/CMakeLists.txt does for the tests that element_vulkan_tests selects";
+}
+
 // Empty when a device is there, else why not.
 inline std::string vulkan_missing() {
   try {
@@ -41,6 +57,8 @@ inline bool only_software_vulkan() {
 
 #define NEUFLOW_REQUIRE_VULKAN()                                                                   \
   do {                                                                                            \
+    const std::string neuflow_deadlock_ = ::neuflow::test::vulkan_deadlocks_under_lsan();         \
+    if (!neuflow_deadlock_.empty()) FAIL() << neuflow_deadlock_;                                  \
     const std::string neuflow_missing_ = ::neuflow::test::vulkan_missing();                       \
     if (!neuflow_missing_.empty()) {                                                              \
       if (::neuflow::test::vulkan_required()) FAIL() << neuflow_missing_;                         \
