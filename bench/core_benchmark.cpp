@@ -8,10 +8,13 @@
 // With --backend vulkan the GPU runs the same pairs and streams (`x_cpu`: the CPU's time over
 // the GPU's), `vulkan_stream_pipelined` streams with a frame in flight (its `x_push`: the
 // plain stream's time over its own), and `vulkan_stream_stages` splits a streamed frame by the
-// GPU's timestamps.
+// GPU's timestamps. `--precision fp32,fp16` runs the GPU's benchmarks in both precisions, fp16
+// as `vulkan_fp16_*` with `x_fp32`: the fp32 time of the same benchmark in this run over its
+// own (a device without fp16 reports that as the benchmark's error instead of a figure).
 //
 //   neuflow-bench-core [--model CKPT] [--threads N] [--sizes 320x256,768x432]
-//                      [--backend cpu|vulkan] [--device N] [benchmark flags]
+//                      [--backend cpu|vulkan] [--device N] [--precision fp32|fp16|fp32,fp16]
+//                      [benchmark flags]
 //
 // Peak RSS is per process: run one size per process for per-size peaks (bench/run-core.sh).
 #include <benchmark/benchmark.h>
@@ -23,6 +26,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -32,12 +36,15 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/model/network_cost.hpp"
+#include "neuflow/model/session_settings.hpp"
 
 namespace {
 
@@ -51,6 +58,7 @@ struct Config {
   int threads = 2;
   bool vulkan = false;  // --backend vulkan: the Vulkan backend too, against the CPU in the same run
   int device = -1;
+  std::vector<neuflow::model::Precision> precisions{neuflow::model::Precision::fp32};  // of the GPU's runs
   std::vector<std::pair<int, int>> sizes{{320, 256}, {512, 384}, {768, 432}, {1024, 448}};
 };
 
@@ -141,15 +149,51 @@ void report(benchmark::State& state, double seconds_per_item, double flops) {
 struct Variant {
   neuflow::model::Backend backend = neuflow::model::Backend::cpu;
   neuflow::model::CpuConvolution convolution = neuflow::model::CpuConvolution::automatic;
+  neuflow::model::Precision precision = neuflow::model::Precision::fp32;
 };
 
 neuflow::model::SessionOptions options_for(const Variant& v) {
-  return {.threads = g_config.threads, .backend = v.backend, .device = g_config.device, .cpu_convolution = v.convolution};
+  return {.threads = g_config.threads,
+          .backend = v.backend,
+          .device = g_config.device,
+          .precision = v.precision,
+          .cpu_convolution = v.convolution};
 }
 
+bool is_fp16(const Variant& v) { return v.precision == neuflow::model::Precision::fp16; }
+
+// What the GPU's benchmarks are named after: vulkan_pair/…, vulkan_fp16_pair/…
+std::string gpu_prefix(neuflow::model::Precision precision) {
+  return precision == neuflow::model::Precision::fp16 ? "vulkan_fp16_" : "vulkan_";
+}
+
+// A GPU benchmark's label; false (the benchmark reports an error, no figure) when the session
+// does not run as asked: fp16 on a device without it runs in fp32.
+bool label_gpu_run(benchmark::State& state, const FlowSession& session, const Variant& v) {
+  if (is_fp16(v) && session.backend_description().find(", fp16") == std::string::npos) {
+    state.SkipWithError(session.fallback_warning().empty() ? "fp16 was asked for and the session runs in fp32"
+                                                           : session.fallback_warning().c_str());
+    return false;
+  }
+  state.SetLabel(session.backend_description());
+  return true;
+}
+
+std::map<std::string, double> g_vulkan_fp32_ms;  // "stream/768x432" → the GPU's fp32 time in this run
+
 // The CPU's default against its direct-only run of the same work, measured just before; on
-// the Vulkan backend, the time against the CPU's default.
-void compare(benchmark::State& state, const std::string& key, const Variant& v) {
+// the Vulkan backend, the time against the CPU's default, and in fp16 against fp32 on the same
+// device. `gpu_key` names the GPU benchmark where it differs from the CPU one it is set against.
+void compare(benchmark::State& state, const std::string& key, const Variant& v, std::string gpu_key = {}) {
+  if (gpu_key.empty()) gpu_key = key;
+  if (v.backend == neuflow::model::Backend::vulkan) {
+    if (!is_fp16(v)) {
+      g_vulkan_fp32_ms[gpu_key] = state.counters["ms"];
+    } else if (const auto it = g_vulkan_fp32_ms.find(gpu_key); it != g_vulkan_fp32_ms.end() && state.counters["ms"] > 0) {
+      state.counters["fp32_ms"] = it->second;
+      state.counters["x_fp32"] = it->second / state.counters["ms"];
+    }
+  }
   if (v.backend == neuflow::model::Backend::cpu && v.convolution == neuflow::model::CpuConvolution::direct) {
     g_direct_ms[key] = state.counters["ms"];
   } else if (v.backend == neuflow::model::Backend::cpu) {
@@ -164,13 +208,13 @@ void compare(benchmark::State& state, const std::string& key, const Variant& v) 
   }
 }
 
-std::map<std::string, double> g_vulkan_push_ms;  // size → vulkan_stream's ms a frame
+std::map<std::string, double> g_vulkan_push_ms;  // "fp32/768x432" → vulkan_stream's ms a frame
 
 void BM_Pair(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));
-  if (variant.backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
   const FrameSequence frames(width, height);
   session.compute(view(frames.at(0)), view(frames.at(1)));  // warm-up: primitives and buffers
+  if (variant.backend != neuflow::model::Backend::cpu && !label_gpu_run(state, session, variant)) return;
   double total = 0;
   std::size_t i = 0;
   for (auto _ : state) {
@@ -187,10 +231,10 @@ void BM_Pair(benchmark::State& state, int width, int height, Variant variant) {
 
 void BM_Stream(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));
-  if (variant.backend != neuflow::model::Backend::cpu) state.SetLabel(session.backend_description());
   const FrameSequence frames(width, height);
   session.push(view(frames.at(0)));
   session.push(view(frames.at(1)));  // warm-up
+  if (variant.backend != neuflow::model::Backend::cpu && !label_gpu_run(state, session, variant)) return;
   double total = 0;
   std::size_t i = 2;
   for (auto _ : state) {
@@ -205,7 +249,8 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
          neuflow::model::network_cost(height, width).stream_frame());
   compare(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), variant);
   if (variant.backend == neuflow::model::Backend::vulkan) {
-    g_vulkan_push_ms[std::to_string(width) + "x" + std::to_string(height)] = state.counters["ms"];
+    g_vulkan_push_ms[std::string(neuflow::model::precision_name(variant.precision)) + "/" + std::to_string(width) + "x" +
+                     std::to_string(height)] = state.counters["ms"];
   }
 }
 
@@ -214,7 +259,6 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
 // computes. x_push: vulkan_stream's time (push, nothing in flight) over this one's.
 void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));
-  state.SetLabel(session.backend_description() + ", " + std::to_string(session.max_in_flight()) + " in flight");
   const FrameSequence frames(width, height);
   std::size_t i = 0;
   for (; i < 4; ++i) {  // warm-up: both ring entries' recordings, with and without a pair
@@ -222,6 +266,11 @@ void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant 
     session.submit(view(frames.at(i)));
   }
   while (session.in_flight() > 1) session.take();
+  if (!label_gpu_run(state, session, variant)) {
+    while (session.in_flight() > 0) session.take();
+    return;
+  }
+  state.SetLabel(session.backend_description() + ", " + std::to_string(session.max_in_flight()) + " in flight");
   double total = 0;
   for (auto _ : state) {
     const cv::Mat frame = frames.at(i);
@@ -236,11 +285,12 @@ void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant 
   report(state, total / static_cast<double>(state.iterations()),
          neuflow::model::network_cost(height, width).stream_frame());
   const std::string key = std::to_string(width) + "x" + std::to_string(height);
-  if (const auto it = g_vulkan_push_ms.find(key); it != g_vulkan_push_ms.end() && state.counters["ms"] > 0) {
-    state.counters["push_ms"] = it->second;
-    state.counters["x_push"] = it->second / state.counters["ms"];
+  const auto push = g_vulkan_push_ms.find(std::string(neuflow::model::precision_name(variant.precision)) + "/" + key);
+  if (push != g_vulkan_push_ms.end() && state.counters["ms"] > 0) {
+    state.counters["push_ms"] = push->second;
+    state.counters["x_push"] = push->second / state.counters["ms"];
   }
-  compare(state, "stream/" + key, variant);
+  compare(state, "stream/" + key, variant, "stream_pipelined/" + key);
 }
 
 // The stages the per-stage benchmarks report (refinement iterations summed per scale).
@@ -292,10 +342,10 @@ void BM_StreamStages(benchmark::State& state, int width, int height, Variant var
 // and x_cpu_STAGE the CPU's time for that stage in this run over the GPU's.
 void BM_VulkanStreamStages(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));
-  state.SetLabel(session.backend_description());
   const FrameSequence frames(width, height);
   session.push(view(frames.at(0)));
   session.push(view(frames.at(1)));  // warm-up: records the command buffers
+  if (!label_gpu_run(state, session, variant)) return;
   if (session.device_stage_times().empty()) {
     state.SkipWithError("this device's compute queue has no timestamps (`neuflow devices`)");
     return;
@@ -323,6 +373,24 @@ void BM_VulkanStreamStages(benchmark::State& state, int width, int height, Varia
   }
   state.counters["device_ms"] = device_ms;
   state.counters["host_ms"] = host_seconds * 1e3 / n;
+}
+
+// The whole of `text` as an int, or nothing.
+std::optional<int> parse_int(const std::string& text) {
+  int value = 0;
+  const char* end = text.data() + text.size();
+  const auto [stop, error] = std::from_chars(text.data(), end, value);
+  if (text.empty() || error != std::errc() || stop != end) return std::nullopt;
+  return value;
+}
+
+// An integer option's value that `check` accepts; nothing, once the reason is printed, else.
+std::optional<int> int_option(const char* name, const std::string& value, std::optional<std::string> (*check)(int)) {
+  const auto number = parse_int(value);
+  const auto problem = number ? check(*number) : std::optional<std::string>("expected a whole number");
+  if (!problem) return number;
+  std::fprintf(stderr, "neuflow-bench-core: %s '%s': %s\n", name, value.c_str(), problem->c_str());
+  return std::nullopt;
 }
 
 // Our own options are taken out of argv before Google Benchmark sees the rest.
@@ -357,7 +425,11 @@ int main(int argc, char** argv) {
   std::string value;
   if (take_option(argc, argv, "--model", value)) g_config.model = value;
   if (take_option(argc, argv, "--frames", value)) g_config.frames = value;
-  if (take_option(argc, argv, "--threads", value)) g_config.threads = std::stoi(value);
+  if (take_option(argc, argv, "--threads", value)) {
+    const auto threads = int_option("--threads", value, neuflow::model::check_threads);
+    if (!threads) return 64;
+    g_config.threads = *threads;
+  }
   if (take_option(argc, argv, "--backend", value)) {
     if (value != "cpu" && value != "vulkan") {
       std::fprintf(stderr, "neuflow-bench-core: --backend wants cpu or vulkan (vulkan also runs the CPU, to compare), got '%s'\n",
@@ -366,7 +438,27 @@ int main(int argc, char** argv) {
     }
     g_config.vulkan = value == "vulkan";
   }
-  if (take_option(argc, argv, "--device", value)) g_config.device = std::stoi(value);
+  if (take_option(argc, argv, "--device", value)) {
+    const auto device = int_option("--device", value, neuflow::model::check_device);
+    if (!device) return 64;
+    g_config.device = *device;
+  }
+  if (take_option(argc, argv, "--precision", value)) {
+    g_config.precisions.clear();
+    for (std::size_t pos = 0; pos <= value.size();) {
+      const std::size_t comma = std::min(value.find(',', pos), value.size());
+      const auto precision = neuflow::model::parse_precision(value.substr(pos, comma - pos));
+      if (!precision) {
+        std::fprintf(stderr, "neuflow-bench-core: --precision wants fp32, fp16 or fp32,fp16, got '%s'\n", value.c_str());
+        return 64;
+      }
+      g_config.precisions.push_back(*precision);
+      pos = comma + 1;
+    }
+    // fp32 first, so that each fp16 benchmark finds the fp32 time it is set against.
+    std::sort(g_config.precisions.begin(), g_config.precisions.end());
+    g_config.precisions.erase(std::unique(g_config.precisions.begin(), g_config.precisions.end()), g_config.precisions.end());
+  }
   if (take_option(argc, argv, "--sizes", value)) {
     g_config.sizes.clear();
     for (std::size_t pos = 0; pos < value.size();) {
@@ -393,7 +485,6 @@ int main(int argc, char** argv) {
     using neuflow::model::Backend;
     using neuflow::model::CpuConvolution;
     const Variant direct{Backend::cpu, CpuConvolution::direct}, cpu{Backend::cpu, CpuConvolution::automatic};
-    const Variant vulkan{Backend::vulkan, CpuConvolution::automatic};
     for (const char* mode : {"pair", "stream"}) {
       const auto run = std::string(mode) == "pair" ? BM_Pair : BM_Stream;
       benchmark::RegisterBenchmark(("direct_" + std::string(mode) + "/" + size).c_str(), run, w, h, direct)
@@ -403,15 +494,17 @@ int main(int argc, char** argv) {
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
     }
-    if (g_config.vulkan) {
-      // Lavapipe (Vulkan on the CPU) runs these too, but its times say nothing of a GPU's.
-      benchmark::RegisterBenchmark(("vulkan_pair/" + size).c_str(), BM_Pair, w, h, vulkan)
+    // Lavapipe (Vulkan on the CPU) runs these too, but its times say nothing of a GPU's.
+    for (const auto precision : g_config.vulkan ? g_config.precisions : std::vector<neuflow::model::Precision>{}) {
+      const Variant vulkan{Backend::vulkan, CpuConvolution::automatic, precision};
+      const std::string prefix = gpu_prefix(precision);
+      benchmark::RegisterBenchmark((prefix + "pair/" + size).c_str(), BM_Pair, w, h, vulkan)
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
-      benchmark::RegisterBenchmark(("vulkan_stream/" + size).c_str(), BM_Stream, w, h, vulkan)
+      benchmark::RegisterBenchmark((prefix + "stream/" + size).c_str(), BM_Stream, w, h, vulkan)
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
-      benchmark::RegisterBenchmark(("vulkan_stream_pipelined/" + size).c_str(), BM_StreamPipelined, w, h, vulkan)
+      benchmark::RegisterBenchmark((prefix + "stream_pipelined/" + size).c_str(), BM_StreamPipelined, w, h, vulkan)
           ->Unit(benchmark::kMillisecond)
           ->MinTime(2.0);
     }
@@ -421,8 +514,10 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("stream_stages/" + size).c_str(), BM_StreamStages, w, h, cpu)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(3);
-    if (g_config.vulkan) {
-      benchmark::RegisterBenchmark(("vulkan_stream_stages/" + size).c_str(), BM_VulkanStreamStages, w, h, vulkan)
+    for (const auto precision : g_config.vulkan ? g_config.precisions : std::vector<neuflow::model::Precision>{}) {
+      const Variant vulkan{Backend::vulkan, CpuConvolution::automatic, precision};
+      const std::string prefix = gpu_prefix(precision);
+      benchmark::RegisterBenchmark((prefix + "stream_stages/" + size).c_str(), BM_VulkanStreamStages, w, h, vulkan)
           ->Unit(benchmark::kMillisecond)
           ->Iterations(3);
     }
