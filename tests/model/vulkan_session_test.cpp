@@ -8,8 +8,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <optional>
@@ -46,6 +48,33 @@ Errors compare(const flow::FlowField& a, const flow::FlowField& b) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
   return compare(a.uv.data(), b.uv.data(), std::min(a.uv.size(), b.uv.size()));
+}
+
+// fp16's end-point error against fp32, printed; its bound is relative to the flow's size.
+struct Fp16Error {
+  double epe = 0, worst = 0;         // mean and largest end-point error, px
+  double magnitude = 0, largest = 0;  // mean and largest |flow| in fp32, px
+};
+
+Fp16Error fp16_error(const flow::FlowField& exact, const flow::FlowField& half, int w, int h) {
+  Fp16Error r;
+  const std::size_t n = exact.pixel_count();
+  EXPECT_EQ(half.pixel_count(), n);
+  for (std::size_t p = 0; p < n && p < half.pixel_count(); ++p) {
+    const double du = half.uv[2 * p] - exact.uv[2 * p], dv = half.uv[2 * p + 1] - exact.uv[2 * p + 1];
+    const double e = std::sqrt(du * du + dv * dv);
+    const double m = std::hypot(static_cast<double>(exact.uv[2 * p]), static_cast<double>(exact.uv[2 * p + 1]));
+    r.epe += e;
+    r.magnitude += m;
+    r.worst = std::max(r.worst, e);
+    r.largest = std::max(r.largest, m);
+  }
+  r.epe /= static_cast<double>(std::max<std::size_t>(n, 1));
+  r.magnitude /= static_cast<double>(std::max<std::size_t>(n, 1));
+  std::printf("fp16 vs fp32 at %dx%d: mean EPE %.4f px (%.3f %% of the mean |flow| %.2f px), max %.4f px "
+              "(%.3f %% of the largest |flow| %.2f px)\n",
+              w, h, r.epe, 100 * r.epe / r.magnitude, r.magnitude, r.worst, 100 * r.worst / r.largest, r.largest);
+  return r;
 }
 
 class VulkanSession : public ::testing::Test {
@@ -408,27 +437,10 @@ TEST_F(VulkanSession, Fp16StaysWithinItsBoundOfFp32) {
     cv::Mat a, b;
     cv::resize(frames_[0], a, cv::Size(w, h));
     cv::resize(frames_[1], b, cv::Size(w, h));
-    const auto exact = fp32_session.compute(view_of(a), view_of(b));
-    const auto half = fp16_session.compute(view_of(a), view_of(b));
-    double epe = 0, worst = 0, magnitude = 0, largest = 0;
-    const std::size_t n = exact.pixel_count();
-    for (std::size_t p = 0; p < n; ++p) {
-      const double du = half.uv[2 * p] - exact.uv[2 * p], dv = half.uv[2 * p + 1] - exact.uv[2 * p + 1];
-      const double e = std::sqrt(du * du + dv * dv);
-      const double m = std::hypot(static_cast<double>(exact.uv[2 * p]), static_cast<double>(exact.uv[2 * p + 1]));
-      epe += e;
-      magnitude += m;
-      worst = std::max(worst, e);
-      largest = std::max(largest, m);
-    }
-    epe /= static_cast<double>(n);
-    magnitude /= static_cast<double>(n);
-    std::printf("fp16 vs fp32 at %dx%d: mean EPE %.4f px (%.3f %% of the mean |flow| %.2f px), max %.4f px "
-                "(%.3f %% of the largest |flow| %.2f px)\n",
-                w, h, epe, 100 * epe / magnitude, magnitude, worst, 100 * worst / largest, largest);
-    RecordProperty("fp16_mean_epe_" + std::to_string(w) + "x" + std::to_string(h), std::to_string(epe));
-    EXPECT_LT(epe, 0.005 * magnitude) << w << "x" << h;
-    EXPECT_LT(worst, 0.01 * largest) << w << "x" << h;
+    const Fp16Error e = fp16_error(fp32_session.compute(view_of(a), view_of(b)), fp16_session.compute(view_of(a), view_of(b)), w, h);
+    RecordProperty("fp16_mean_epe_" + std::to_string(w) + "x" + std::to_string(h), std::to_string(e.epe));
+    EXPECT_LT(e.epe, 0.005 * e.magnitude) << w << "x" << h;
+    EXPECT_LT(e.worst, 0.01 * e.largest) << w << "x" << h;
   }
 }
 
@@ -482,6 +494,37 @@ TEST_F(VulkanSession, DeviceTimestampsTimeEveryStageOfAFrame) {
   cpu.push(view_of(f0));
   cpu.push(view_of(f1));
   EXPECT_TRUE(cpu.device_stage_times().empty());
+}
+
+// On a real GPU (CI has only lavapipe, a CPU device, so this skips there and never fails for
+// it): backend=auto takes the first discrete or integrated GPU, and at the benchmarks' size
+// its flows are the CPU's in fp32 and within fp16's bound of fp32 where the GPU has fp16.
+TEST_F(VulkanSession, OnARealGpuAutoTakesItAndGivesTheCpusFlow) {
+  if (test::only_software_vulkan()) {
+    GTEST_SKIP() << "only software Vulkan devices here (lavapipe): this test needs a discrete or integrated GPU";
+  }
+  const auto devices = list_gpu_devices();
+  const auto gpu = std::find_if(devices.begin(), devices.end(), [](const GpuDevice& d) { return d.is_gpu(); });
+  ASSERT_NE(gpu, devices.end());
+  const Iterations iterations{1, 4};
+  FlowSession cpu(model_, {.iterations = iterations, .threads = 2, .backend = Backend::cpu});
+  FlowSession automatic(model_, {.iterations = iterations, .backend = Backend::automatic});
+  EXPECT_EQ(automatic.backend_description().rfind("vulkan device " + std::to_string(gpu->index) + " ", 0), 0u)
+      << automatic.backend_description();
+  EXPECT_TRUE(automatic.fallback_warning().empty()) << automatic.fallback_warning();
+  cv::Mat a, b;
+  cv::resize(frames_[0], a, cv::Size(768, 432));
+  cv::resize(frames_[1], b, cv::Size(768, 432));
+  const auto exact = automatic.compute(view_of(a), view_of(b));
+  const Errors e = compare(exact, cpu.compute(view_of(a), view_of(b)));
+  EXPECT_LT(e.max, 1e-2);
+  EXPECT_LT(e.mean, 1e-3);
+  if (!gpu->fp16) return;
+  FlowSession half(model_, {.iterations = iterations, .backend = Backend::automatic, .precision = Precision::fp16});
+  EXPECT_NE(half.backend_description().find(", fp16"), std::string::npos) << half.backend_description();
+  const Fp16Error f = fp16_error(exact, half.compute(view_of(a), view_of(b)), 768, 432);
+  EXPECT_LT(f.epe, 0.005 * f.magnitude);
+  EXPECT_LT(f.worst, 0.01 * f.largest);
 }
 
 TEST(VulkanDevices, EachDeviceHasANameTypeAndMemory) {
