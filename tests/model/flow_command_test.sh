@@ -5,12 +5,9 @@
 set -u
 neuflow=$1
 python=$2
-fixture="${NEUFLOW_SHARED_DIR:-$(dirname "$0")/../../../shared}/fixtures/neuflow-v2-seed0"
-if [ ! -f "$fixture/checkpoint.pth" ]; then
-  echo "fixture not found: $fixture (set NEUFLOW_SHARED_DIR)"
-  if [ -n "${NEUFLOW_REQUIRE_FIXTURES:-}" ] && [ "${NEUFLOW_REQUIRE_FIXTURES}" != 0 ]; then exit 1; fi
-  exit 77
-fi
+source "$(dirname "$0")/../support/require.sh"
+fixture="$(neuflow_fixtures)/neuflow-v2-seed0"
+require_fixture "$fixture/checkpoint.pth"
 if ! "$python" -c 'import numpy' 2>/dev/null; then
   echo "$python cannot import numpy (install python3-numpy)"; exit 1
 fi

@@ -6,17 +6,10 @@
 # Usage: flow_command_vulkan_test.sh NEUFLOW_BINARY
 set -u
 neuflow=$1
-fixture="${NEUFLOW_SHARED_DIR:-$(dirname "$0")/../../../shared}/fixtures/neuflow-v2-seed0"
-if [ ! -f "$fixture/checkpoint.pth" ]; then
-  echo "fixture not found: $fixture (set NEUFLOW_SHARED_DIR)"
-  if [ -n "${NEUFLOW_REQUIRE_FIXTURES:-}" ] && [ "${NEUFLOW_REQUIRE_FIXTURES}" != 0 ]; then exit 1; fi
-  exit 77
-fi
-if ! "$neuflow" devices | grep -q '^0: '; then
-  echo "no Vulkan device here"
-  if [ -n "${NEUFLOW_REQUIRE_VULKAN:-}" ] && [ "${NEUFLOW_REQUIRE_VULKAN}" != 0 ]; then exit 1; fi
-  exit 77
-fi
+source "$(dirname "$0")/../support/require.sh"
+fixture="$(neuflow_fixtures)/neuflow-v2-seed0"
+require_fixture "$fixture/checkpoint.pth"
+require_vulkan "$neuflow"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
