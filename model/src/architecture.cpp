@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <unordered_set>
 
+#include "network_dims.hpp"
+
 namespace neuflow::model {
 
 namespace {
@@ -49,14 +51,15 @@ class LayerTable {
     conv(prefix + ".2", out, out, 3, false, Stage::merge_s8, 8, runs);
     batch_norm(prefix + ".3", out, Stage::merge_s8);
   }
-  // Refinement block: 212 input channels, 66 outputs (2 flow + 64 hidden), run per iteration.
+  // Refinement block: its input (correlation, context, hidden state, flow, radius) to the flow
+  // update and the next hidden state, run per iteration.
   void refine(const std::string& prefix, int inter, Stage stage, int scale) {
-    conv(prefix + ".conv1.conv", 212, 128, 3, false, stage, scale);
-    conv(prefix + ".conv2.conv", 128, inter, 3, false, stage, scale);
+    conv(prefix + ".conv1.conv", kRefineInputChannels, kRefineHiddenWidth, 3, false, stage, scale);
+    conv(prefix + ".conv2.conv", kRefineHiddenWidth, inter, 3, false, stage, scale);
     for (int i = 0; i < 5; ++i) {
       conv(prefix + ".conv_layers." + std::to_string(i) + ".conv", inter, inter, 3, false, stage, scale);
     }
-    conv(prefix + ".conv3", inter, 66, 3, true, stage, scale);
+    conv(prefix + ".conv3", inter, kRefineOutputChannels, 3, true, stage, scale);
   }
 
  private:
@@ -69,21 +72,21 @@ std::vector<LayerSpec> build_layers() {
   constexpr Stage B = Stage::backbone;
   t.conv_block("backbone.block_8_1", 3, 256, 8, B, 8);
   t.conv_block("backbone.block_8_2", 3, 128, 6, B, 8);
-  t.conv_block("backbone.block_cat_8", 384, 192, 3, B, 8);
+  t.conv_block("backbone.block_cat_8", 384, kFeatureChannels, 3, B, 8);
   t.conv_block("backbone.block_16_1", 3, 128, 6, B, 16);
-  t.conv_block("backbone.block_8_16", 192, 128, 6, B, 16);
-  t.conv_block("backbone.block_cat_16", 256, 190, 3, B, 16);
-  t.attention_layer("cross_attn_s16.layers.0", 192);
-  t.attention_layer("cross_attn_s16.layers.1", 192);
-  t.batch_norm("cross_attn_s16.norm", 192, Stage::cross_attention);
-  t.merge("merge_s8", 256, 128, 2);  // both frames' features
-  t.merge("context_merge_s8", 128, 64, 1);
+  t.conv_block("backbone.block_8_16", kFeatureChannels, 128, 6, B, 16);
+  t.conv_block("backbone.block_cat_16", 256, kBackbone16Channels, 3, B, 16);
+  t.attention_layer("cross_attn_s16.layers.0", kFeatureChannels);
+  t.attention_layer("cross_attn_s16.layers.1", kFeatureChannels);
+  t.batch_norm("cross_attn_s16.norm", kFeatureChannels, Stage::cross_attention);
+  t.merge("merge_s8", 2 * kMatchingChannels, kMatchingChannels, 2);  // both frames' features
+  t.merge("context_merge_s8", 2 * kContextChannels, kContextChannels, 1);
   t.refine("refine_s16", 128, Stage::refine_s16, 16);
   t.refine("refine_s8", 96, Stage::refine_s8, 8);
   t.conv_block("conv_s8", 3, 128, 8, Stage::upsample_features, 8);
-  t.conv("upsample_s8.conv1", 130, 256, 3, true, Stage::upsampler, 8);
+  t.conv("upsample_s8.conv1", 2 + 128, 256, 3, true, Stage::upsampler, 8);  // flow, conv_s8
   t.conv("upsample_s8.conv2", 256, 512, 3, true, Stage::upsampler, 8);
-  t.conv("upsample_s8.conv3", 512, 576, 1, true, Stage::upsampler, 8);
+  t.conv("upsample_s8.conv3", 512, kUpsampleMaskChannels, 1, true, Stage::upsampler, 8);
   return layers;
 }
 

@@ -2,7 +2,8 @@
 // How an input frame maps onto the network's input and how the flow maps back: either
 // edge-replicated padding to multiples of 16 (centred), or a resize to a chosen model size.
 #include "neuflow/flow/flow_field.hpp"
-#include "neuflow/model/flow_session.hpp"
+#include "neuflow/model/image_view.hpp"
+#include "neuflow/model/session_settings.hpp"
 #include "tensor.hpp"
 
 namespace neuflow::model {

@@ -126,11 +126,13 @@ class WeightReader {
   }
 
   RefineWeights refine(const std::string& prefix) const {
-    constexpr int in_total = kCorrChannels + kContextChannels + kHiddenChannels + 2 + 1;  // 212
+    constexpr int in_total = kRefineInputChannels;
+    // Checkpoint input order: corr, context, hidden, flow (2), radius (1).
+    constexpr int corr = 0, context = corr + kCorrChannels, hidden = context + kContextChannels,
+                  flow = hidden + kHiddenChannels, radius = flow + 2;
     RefineWeights r;
     const ConvWeights full = conv(prefix + ".conv1.conv");
     if (full.in_channels != in_total) throw std::logic_error(prefix + ": the refinement's inputs changed");
-    // Checkpoint input order: corr 0..80, context 81..144, hidden 145..208, flow 209..210, r 211.
     const auto slice = [&](const std::vector<std::pair<int, int>>& ranges) {
       ConvWeights part;
       part.out_channels = full.out_channels;
@@ -145,8 +147,8 @@ class WeightReader {
       }
       return part;
     };
-    r.conv1_dynamic = slice({{0, 81}, {145, 209}, {209, 211}});
-    r.conv1_constant = slice({{81, 145}, {211, 212}});
+    r.conv1_dynamic = slice({{corr, context}, {hidden, flow}, {flow, radius}});
+    r.conv1_constant = slice({{context, hidden}, {radius, in_total}});
     r.conv2 = conv(prefix + ".conv2.conv");
     r.inter_dim = r.conv2.out_channels;
     for (int i = 0; i < 5; ++i) r.conv_layers[i] = conv(prefix + ".conv_layers." + std::to_string(i) + ".conv");

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "neuflow/model/checkpoint.hpp"
+#include "network_dims.hpp"
 
 namespace neuflow::model {
 
@@ -47,16 +48,6 @@ struct AttentionLayerWeights {
   LinearWeights mlp2;  // 384 → 192, no bias
   LayerNormWeights norm2;
 };
-
-// Refinement input channels, in the order the dynamic part of conv1 reads them.
-inline constexpr int kCorrChannels = 81;
-inline constexpr int kHiddenChannels = 64;
-inline constexpr int kContextChannels = 64;
-// The attention's 192 output channels: context first, then the features that are matched.
-inline constexpr int kMatchingChannels = 128;
-inline constexpr int kRefineDynamicChannels = kCorrChannels + kHiddenChannels + 2;  // corr, hidden, flow
-inline constexpr int kRefineConstantChannels = kContextChannels + 1;                  // context, radius
-inline constexpr float kCorrRadiusPlane = 4.0f;
 
 struct RefineWeights {
   int inter_dim = 0;

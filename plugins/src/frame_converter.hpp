@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "neuflow/model/flow_session.hpp"
+#include "neuflow/model/image_view.hpp"
 
 namespace neuflow::gst {
 

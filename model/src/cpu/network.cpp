@@ -8,15 +8,12 @@ namespace neuflow::model {
 
 namespace {
 
-constexpr int kContext = kContextChannels;  // channels 0..63 are context, 64.. are features
-constexpr int kFeatures = kMatchingChannels;
-
 void observe(const StageObserver* observer, const std::string& name, int frame, const Tensor& t) {
   if (observer && *observer) (*observer)(StageTensor{name, frame, t.h, t.w, t.c, t.data.data()});
 }
 
-ChannelSlice features_of(const Tensor& t) { return {&t, kContext, kFeatures}; }
-ChannelSlice context_of(const Tensor& t) { return {&t, 0, kContext}; }
+ChannelSlice features_of(const Tensor& t) { return {&t, kContextChannels, kMatchingChannels}; }
+ChannelSlice context_of(const Tensor& t) { return {&t, 0, kContextChannels}; }
 
 // Starts a new arena region: the stage constructed with it may reuse earlier stages' memory.
 PlanContext& next_region(PlanContext& context, const char* name) {
@@ -37,12 +34,12 @@ NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width, CpuConv
       context_{{}, convolution},
       encoder_(w, height, width, first_region(context_, "encoder")),
       attention_(w, height / 16, width / 16, next_region(context_, "cross_attention")),
-      matching_(height / 16, width / 16, kFeatures, next_region(context_, "global_matching")),
+      matching_(height / 16, width / 16, kMatchingChannels, next_region(context_, "global_matching")),
       refine_s16_(w.refine_s16, height / 16, width / 16, Iterations{}.s16, next_region(context_, "refine_s16")),
       merge_(w, height / 8, width / 8, next_region(context_, "merge_refine_s8")),
       refine_s8_(w.refine_s8, height / 8, width / 8, Iterations{}.s8, context_),  // same region: it reads the merges' outputs
       upsampler_(w, height / 8, width / 8, next_region(context_, "upsampler")),
-      context16_(height / 16, width / 16, kContext),
+      context16_(height / 16, width / 16, kContextChannels),
       flow8_(height / 8, width / 8, 2) {
   context_.arena.finalize();
 }

@@ -1,29 +1,37 @@
 #pragma once
-// The compute shaders, compiled to SPIR-V at build time (glslc) and embedded in the library.
+// The compute shaders, compiled to SPIR-V at build time and embedded in the library. Which
+// shaders exist, their SPIR-V and their push-constant structs come from one list, the
+// neuflow_shader() calls in model/CMakeLists.txt (cmake/NeuflowShaders.cmake generates
+// shader_registry.hpp/.cpp from it).
 #include <cstddef>
 #include <cstdint>
 #include <span>
 
 namespace neuflow::model::vulkan {
 
-enum class Shader {
-  conv2d,          // matmul.comp with IMPLICIT_CONV
-  matmul,          // matmul.comp, strided operands
-  avgpool2x,
-  resample,
-  axpby,
-  channel_affine,
-  softmax_rows,
-  layer_norm,
-  local_correlation,
-  refine_update,
-  convex_upsample,
-  frame_u8,        // a frame's 8-bit pixels as the network's input
-};
-inline constexpr std::size_t kShaderCount = 12;
+// Every pipeline shares one push-constant range of this size (VulkanDevice's layout): the
+// smallest maxPushConstantsSize Vulkan guarantees.
+inline constexpr std::size_t kMaxPushConstantBytes = 128;
 
-// fp16: the variant that stores tensors as float16_t (precision.glsl).
-std::span<const std::uint32_t> spirv(Shader shader, bool fp16);
-const char* shader_name(Shader shader);
+struct ShaderInfo {
+  const char* name;
+  std::span<const std::uint32_t> spirv;
+  std::span<const std::uint32_t> spirv_fp16;  // tensors stored as float16_t (precision.glsl)
+  const char* params;                         // its push-constant struct (shaders/params/)
+  std::size_t params_bytes;
+};
+
+}  // namespace neuflow::model::vulkan
+
+#include "shader_registry.hpp"  // Shader, kShaderCount, ShaderParams<Shader>
+
+namespace neuflow::model::vulkan {
+
+const ShaderInfo& shader_info(Shader shader);
+
+inline std::span<const std::uint32_t> spirv(Shader shader, bool fp16) {
+  return fp16 ? shader_info(shader).spirv_fp16 : shader_info(shader).spirv;
+}
+inline const char* shader_name(Shader shader) { return shader_info(shader).name; }
 
 }  // namespace neuflow::model::vulkan

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "network_dims.hpp"
 #include "vulkan/half_float.hpp"
 #include "vulkan/one_shot_commands.hpp"
 
@@ -12,26 +13,14 @@ namespace neuflow::model::vulkan {
 
 namespace {
 
-constexpr int kDim = 192;          // attention tokens' width
-constexpr int kContext = 64;       // channels 0..63 of the attention output and of f8
-constexpr int kFeatures = 128;     // channels 64..191
-constexpr int kCorr = 81, kHidden = 64;
-constexpr int kHiddenOffset = kCorr, kFlowOffset = kCorr + kHidden, kRefineInput = kCorr + kHidden + 2;
+constexpr int kDim = kFeatureChannels;  // attention tokens' width
 // The attention's and matching's score blocks hold at most this many floats (32 MiB), well
 // inside lavapipe's 128 MiB per buffer, so memory stays O(L · block) at any size.
 constexpr int kScoreBlockFloats = 8 << 20;
 constexpr int kLocal = 256;        // invocations per workgroup of the element-wise shaders
 
-enum Act { kNone = 0, kLeakyRelu = 1, kRelu = 2, kGelu = 3 };
-
-struct ConvPush {
-  int in_c, in_h, in_w, in_off, out_c, out_h, out_w, out_off, kernel, stride, pad, act, w_off, bias_off, add_off;
-  float alpha;
-};
-struct MatmulPush {
-  int m, n, k, a_off, a_rs, a_cs, b_off, b_rs, b_cs, c_off, c_rs, c_cs, bias_off, act;
-  float alpha;
-};
+// An activation code of shaders/params/activation.h.
+using Act = int;
 
 // Element-wise shaders loop over what a capped dispatch does not cover (common.glsl).
 uint32_t groups(long count, long per_group) {
@@ -118,8 +107,16 @@ class VulkanNetwork::Recorder {
     vkCmdPipelineBarrier(commands_, stages, stages, 0, 1, &b, 0, nullptr, 0, nullptr);
   }
 
-  void dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
-                uint32_t gx, uint32_t gy = 1) {
+  // S's push constants are its params header's struct (ShaderParams), so recording a shader with
+  // another's parameters does not compile.
+  template <Shader S>
+  void dispatch(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, uint32_t gx,
+                uint32_t gy = 1) {
+    record_dispatch(S, bindings, &push, sizeof push, gx, gy);
+  }
+
+  void record_dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
+                       uint32_t gx, uint32_t gy) {
     barrier();
     std::array<VkBuffer, 4> handles{};
     for (std::size_t i = 0; i < handles.size(); ++i) {
@@ -158,48 +155,40 @@ class VulkanNetwork::Recorder {
   // out = act(conv(in) + bias (+ addend)); out.c must be the layer's output channels.
   void conv(const DeviceConv& w, const View& in, int stride, int pad, Act act, const View& out,
             const View* addend = nullptr) {
-    ConvPush p{in.c, in.h, in.w, in.offset(), out.c, out.h, out.w, out.offset(), w.kernel, stride, pad, act,
+    const Conv2dParams p{in.c, in.h, in.w, in.offset(), out.c, out.h, out.w, out.offset(), w.kernel, stride, pad, act,
                w.weight, w.bias, addend ? addend->offset() : -1, 1.f};
-    dispatch(Shader::conv2d, {&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, &p,
-             sizeof p, tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
+    dispatch<Shader::conv2d>({&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, p,
+                             tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
   }
 
   // Token lists [features][tokens]: out = act(W · in + b).
   void linear(const DeviceLinear& w, const Buffer& in, int in_off, const Buffer& out, int out_off, int tokens,
-              Act act = kNone) {
-    MatmulPush p{w.out_features, tokens, w.in_features, w.weight, w.in_features, 1, in_off, tokens, 1,
+              Act act = kActNone) {
+    const MatmulParams p{w.out_features, tokens, w.in_features, w.weight, w.in_features, 1, in_off, tokens, 1,
                  out_off, tokens, 1, w.bias, act, 1.f};
-    dispatch(Shader::matmul, {&net_.weights_->buffer, &in, &out, nullptr}, &p, sizeof p, tiles(tokens, "attention"),
-             tiles(w.out_features, "attention"));
+    dispatch<Shader::matmul>({&net_.weights_->buffer, &in, &out, nullptr}, p, tiles(tokens, "attention"),
+                             tiles(w.out_features, "attention"));
   }
 
-  void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulPush& p) {
-    dispatch(Shader::matmul, {&a, &b, &c, nullptr}, &p, sizeof p, tiles(p.n, "attention"), tiles(p.m, "attention"));
+  void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulParams& p) {
+    dispatch<Shader::matmul>({&a, &b, &c, nullptr}, p, tiles(p.n, "attention"), tiles(p.m, "attention"));
   }
 
   void resample(const View& src, const View& dst, int factor, bool relu, float scale) {
-    struct {
-      int channels, in_h, in_w, in_off, out_off, factor, relu;
-      float scale;
-    } p{src.c, src.h, src.w, src.offset(), dst.offset(), factor, relu ? 1 : 0, scale};
-    dispatch(Shader::resample, {src.buffer, nullptr, dst.buffer, nullptr}, &p, sizeof p,
-             groups(static_cast<long>(dst.count()), kLocal));
+    const ResampleParams p{src.c, src.h, src.w, src.offset(), dst.offset(), factor, relu ? 1 : 0, scale};
+    dispatch<Shader::resample>({src.buffer, nullptr, dst.buffer, nullptr}, p,
+                               groups(static_cast<long>(dst.count()), kLocal));
   }
 
   void avgpool(const View& src, const View& dst) {
-    struct {
-      int channels, in_h, in_w;
-    } p{src.c, src.h, src.w};
-    dispatch(Shader::avgpool2x, {src.buffer, nullptr, dst.buffer, nullptr}, &p, sizeof p,
-             groups(static_cast<long>(dst.count()), kLocal));
+    const Avgpool2xParams p{src.c, src.h, src.w};
+    dispatch<Shader::avgpool2x>({src.buffer, nullptr, dst.buffer, nullptr}, p,
+                                groups(static_cast<long>(dst.count()), kLocal));
   }
 
   void axpby(float a, const View& x, float b, const View& y, const View& out) {
-    struct {
-      int count, x_off, y_off, out_off;
-      float a, b;
-    } p{out.count(), x.offset(), y.offset(), out.offset(), a, b};
-    dispatch(Shader::axpby, {x.buffer, y.buffer, out.buffer, nullptr}, &p, sizeof p, groups(out.count(), kLocal));
+    const AxpbyParams p{out.count(), x.offset(), y.offset(), out.offset(), a, b};
+    dispatch<Shader::axpby>({x.buffer, y.buffer, out.buffer, nullptr}, p, groups(out.count(), kLocal));
   }
 
   // Reads `v` back and hands it to the observer as NHWC (only when observing).
@@ -259,11 +248,11 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
                                                              std::to_string(height));
   };
   dummy_ = make(4, "a placeholder binding");
-  zeros_ = make(kHidden * hw8 + 2, "zeros");
+  zeros_ = make(kHiddenChannels * hw8 + 2, "zeros");
   for (std::size_t e = 0; e < ring_.size(); ++e) {
     ring_[e].upload = make(3 * hw, "the frame upload", M::upload);
     // Entry 0 also serves the observer, which reads whole stages back.
-    ring_[e].readback = make(e == 0 ? std::max(192 * hw8, 2 * hw) : 2 * hw, "the read-back buffer", M::readback);
+    ring_[e].readback = make(e == 0 ? std::max(kFeatureChannels * hw8, 2 * hw) : 2 * hw, "the read-back buffer", M::readback);
   }
   input_ = make(3 * hw, "the input frame");
   half_ = make(3 * hw / 4, "the 1/2 frame");
@@ -273,8 +262,8 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   cat8_ = make(384 * hw8, "the 1/8 concatenation");
   cat16_ = make(256 * l, "the 1/16 concatenation");
   for (auto& s : slots_) {
-    s.f8 = make(192 * hw8, "frame features at 1/8");
-    s.f16 = make(192 * l, "frame features at 1/16");
+    s.f8 = make(kFeatureChannels * hw8, "frame features at 1/8");
+    s.f16 = make(kFeatureChannels * l, "frame features at 1/16");
     s.up = make(128 * hw8, "the upsampler's frame features");
   }
   q_ = make(kDim * l, "attention queries");
@@ -293,24 +282,24 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   flow16_ = make(2 * l, "flow at 1/16");
   flow8_ = make(2 * hw8, "flow at 1/8");
   const auto make_refine = [&](Refine& r, std::size_t plane) {
-    r.input = make(kRefineInput * plane, "the refinement input");
-    r.constant_in = make((kContext + 1) * plane, "the refinement's constant input");
-    r.constant_out = make(128 * plane, "the refinement's constant part");
-    r.xa = make(128 * plane, "refinement scratch");
-    r.xb = make(128 * plane, "refinement scratch");
-    r.out66 = make(66 * plane, "the refinement output");
+    r.input = make(kRefineDynamicChannels * plane, "the refinement input");
+    r.constant_in = make(kRefineConstantChannels * plane, "the refinement's constant input");
+    r.constant_out = make(kRefineHiddenWidth * plane, "the refinement's constant part");
+    r.xa = make(kRefineHiddenWidth * plane, "refinement scratch");
+    r.xb = make(kRefineHiddenWidth * plane, "refinement scratch");
+    r.out66 = make(kRefineOutputChannels * plane, "the refinement output");
   };
   make_refine(refine16_, l);
   make_refine(refine8_, hw8);
-  feature_in_ = make(256 * hw8, "the 1/8 feature merge input");
-  merge_tmp_ = make(128 * hw8, "merge scratch");
-  context_in_ = make(128 * hw8, "the context merge input");
-  context_tmp_ = make(64 * hw8, "context merge scratch");
-  for (auto& f : features8_) f = make(128 * hw8, "merged features at 1/8");
+  feature_in_ = make(2 * kMatchingChannels * hw8, "the 1/8 feature merge input");
+  merge_tmp_ = make(kMatchingChannels * hw8, "merge scratch");
+  context_in_ = make(2 * kContextChannels * hw8, "the context merge input");
+  context_tmp_ = make(kContextChannels * hw8, "context merge scratch");
+  for (auto& f : features8_) f = make(kMatchingChannels * hw8, "merged features at 1/8");
   upsample_in_ = make(130 * hw8, "the upsampler input");
   upsample1_ = make(256 * hw8, "the upsampler's first layer");
   upsample2_ = make(512 * hw8, "the upsampler's second layer");
-  mask_ = make(576 * hw8, "the upsampling mask");
+  mask_ = make(kUpsampleMaskChannels * hw8, "the upsampling mask");
   flow_full_ = make(2 * hw, "the full-resolution flow");
 
   // The buffers release themselves; the pool and fence are released here if setting up fails.
@@ -358,13 +347,13 @@ void VulkanNetwork::release_handles() {
 // What no pass writes: the position channels of f16, the matching grid, the radius planes.
 void VulkanNetwork::initialise_constants() {
   const std::size_t l = tokens_, hw8 = static_cast<std::size_t>(h8_) * w8_;
-  // Positions (2·L), the grid (2·L), then radius planes of 4.0 (as many as the larger plane).
-  std::vector<float> c(4 * l + hw8, 4.f);
+  // Positions (2·L), the grid (2·L), then radius planes (as many as the larger plane).
+  std::vector<float> c(4 * l + hw8, kCorrRadiusPlane);
   for (int y = 0; y < h16_; ++y) {
     for (int x = 0; x < w16_; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * w16_ + x;
-      c[p] = static_cast<float>(y) - static_cast<float>(h16_) / 2.f;            // f16 channel 190
-      c[l + p] = static_cast<float>(x) - static_cast<float>(w16_) / 2.f;        // f16 channel 191
+      c[p] = static_cast<float>(y) - static_cast<float>(h16_) / 2.f;            // f16 position channel y
+      c[l + p] = static_cast<float>(x) - static_cast<float>(w16_) / 2.f;        // f16 position channel x
       c[2 * l + p] = static_cast<float>(x);                                     // grid x
       c[3 * l + p] = static_cast<float>(y);                                     // grid y
     }
@@ -375,12 +364,12 @@ void VulkanNetwork::initialise_constants() {
   OneShotCommands commands(device_);
   VkCommandBuffer cb = commands.buffer();
   for (auto& s : slots_) {
-    const VkBufferCopy pos{0, 190 * l * e, 2 * l * e};
+    const VkBufferCopy pos{0, kBackbone16Channels * l * e, 2 * l * e};
     vkCmdCopyBuffer(cb, staging.handle(), s.f16.handle(), 1, &pos);
   }
   const VkBufferCopy grid{2 * l * e, 0, 2 * l * e};
   vkCmdCopyBuffer(cb, staging.handle(), grid_.handle(), 1, &grid);
-  const VkBufferCopy radius16{4 * l * e, kContext * l * e, l * e}, radius8{4 * l * e, kContext * hw8 * e, hw8 * e};
+  const VkBufferCopy radius16{4 * l * e, kContextChannels * l * e, l * e}, radius8{4 * l * e, kContextChannels * hw8 * e, hw8 * e};
   vkCmdCopyBuffer(cb, staging.handle(), refine16_.constant_in.handle(), 1, &radius16);
   vkCmdCopyBuffer(cb, staging.handle(), refine8_.constant_in.handle(), 1, &radius8);
   vkCmdFillBuffer(cb, zeros_.handle(), 0, VK_WHOLE_SIZE, 0);
@@ -611,11 +600,8 @@ void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* fram
   const View input{&input_, 0, 3, h, w}, half{&half_, 0, 3, h / 2, w / 2}, quarter{&quarter_, 0, 3, h / 4, w / 4},
       eighth{&eighth_, 0, 3, h / 8, w / 8};
   if (frame) {
-    struct {
-      int in_w, in_h, out_w, out_h, pad_left, pad_top, swap;
-    } p{frame->width, frame->height, w, h, frame->pad_left, frame->pad_top, frame->swap ? 1 : 0};
-    r.dispatch(Shader::frame_u8, {&r.upload(), nullptr, &input_, nullptr}, &p, sizeof p,
-               groups(static_cast<long>(h) * w, kLocal));
+    const FrameU8Params p{frame->width, frame->height, w, h, frame->pad_left, frame->pad_top, frame->swap ? 1 : 0};
+    r.dispatch<Shader::frame_u8>({&r.upload(), nullptr, &input_, nullptr}, p, groups(static_cast<long>(h) * w, kLocal));
   } else {
     r.copy_raw(r.upload(), input_, static_cast<std::size_t>(3) * h * w);
   }
@@ -626,10 +612,10 @@ void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* fram
   Slot& s = slots_[static_cast<std::size_t>(slot)];
   const auto block = [&](const DeviceBlock& b, const View& in, int stride, int pad, const View& out) {
     const View tmp{&encode_tmp_, 0, b.conv1.out_channels, out.h, out.w};
-    r.conv(b.conv1, in, stride, pad, kLeakyRelu, tmp);
-    r.conv(b.conv2, tmp, 1, 1, kLeakyRelu, out);
+    r.conv(b.conv1, in, stride, pad, kActLeakyRelu, tmp);
+    r.conv(b.conv2, tmp, 1, 1, kActLeakyRelu, out);
   };
-  const View cat8{&cat8_, 0, 384, h8_, w8_}, f8{&s.f8, 0, 192, h8_, w8_};
+  const View cat8{&cat8_, 0, 384, h8_, w8_}, f8{&s.f8, 0, kFeatureChannels, h8_, w8_};
   block(wt.block_8_1, half, 4, 2, cat8.channels(0, 256));
   block(wt.block_8_2, quarter, 2, 2, cat8.channels(256, 128));
   block(wt.block_cat_8, cat8, 1, 1, f8);
@@ -637,7 +623,7 @@ void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* fram
   const View cat16{&cat16_, 0, 256, h16_, w16_};
   block(wt.block_16_1, eighth, 2, 2, cat16.channels(0, 128));
   block(wt.block_8_16, f8, 2, 2, cat16.channels(128, 128));
-  block(wt.block_cat_16, cat16, 1, 1, View{&s.f16, 0, 190, h16_, w16_});
+  block(wt.block_cat_16, cat16, 1, 1, View{&s.f16, 0, kBackbone16Channels, h16_, w16_});
   r.mark("backbone_s16");
   block(wt.conv_s8, input, 8, 0, View{&s.up, 0, 128, h8_, w8_});
   r.mark("conv_s8");
@@ -652,26 +638,22 @@ void VulkanNetwork::record_attention_layer(Recorder& r, const DeviceAttentionLay
   for (int r0 = 0; r0 < l; r0 += block_rows_) {
     const int n = std::min(block_rows_, l - r0);
     // scores[i][j] = q[:, r0 + i] · k[:, j]
-    r.matmul(q_, k_, scores_, {n, l, kDim, r0, 1, l, 0, l, 1, 0, l, 1, -1, kNone, 1.f});
-    struct {
-      int rows, cols, off;
-    } sp{n, l, 0};
-    r.dispatch(Shader::softmax_rows, {nullptr, nullptr, &scores_, nullptr}, &sp, sizeof sp, static_cast<uint32_t>(n));
+    r.matmul(q_, k_, scores_, {n, l, kDim, r0, 1, l, 0, l, 1, 0, l, 1, -1, kActNone, 1.f});
+    r.dispatch<Shader::softmax_rows>({nullptr, nullptr, &scores_, nullptr}, SoftmaxRowsParams{n, l, 0},
+                                     static_cast<uint32_t>(n));
     // message[:, r0 + i] = v · scores[i]^T
-    r.matmul(v_, scores_, message_, {kDim, n, l, 0, l, 1, 0, 1, l, r0, l, 1, -1, kNone, 1.f});
+    r.matmul(v_, scores_, message_, {kDim, n, l, 0, l, 1, 0, 1, l, r0, l, 1, -1, kActNone, 1.f});
   }
   r.linear(w.merge, message_, 0, attn_tmp_, 0, l);
   const auto layer_norm = [&](const DeviceLayerNorm& nw, const Buffer& x, const Buffer& dst, int dst_off,
                               const Buffer* residual) {
-    struct {
-      int dim, tokens, x_off, out_off, res_off, gamma_off, beta_off;
-    } p{kDim, l, 0, dst_off, residual ? 0 : -1, nw.gamma, nw.beta};
-    r.dispatch(Shader::layer_norm, {&weights_->buffer, &x, &dst, residual}, &p, sizeof p, groups(l, kLocal));
+    const LayerNormParams p{kDim, l, 0, dst_off, residual ? 0 : -1, nw.gamma, nw.beta};
+    r.dispatch<Shader::layer_norm>({&weights_->buffer, &x, &dst, residual}, p, groups(l, kLocal));
   };
   // mlp input = concat[src, LayerNorm1(merge(message))]
   layer_norm(w.norm1, attn_tmp_, mlp_in_, kDim * l, nullptr);
   r.copy(View{&src, 0, kDim, 1, l}, View{&mlp_in_, 0, kDim, 1, l});
-  r.linear(w.mlp0, mlp_in_, 0, mlp_hidden_, 0, l, kGelu);
+  r.linear(w.mlp0, mlp_in_, 0, mlp_hidden_, 0, l, kActGelu);
   r.linear(w.mlp2, mlp_hidden_, 0, attn_tmp_, 0, l);
   layer_norm(w.norm2, attn_tmp_, out, 0, &src);
 }
@@ -679,39 +661,36 @@ void VulkanNetwork::record_attention_layer(Recorder& r, const DeviceAttentionLay
 void VulkanNetwork::record_refinement(Recorder& r, const DeviceRefine& w, Refine& b, const View& f0, const View& f1,
                                       const View& flow, int iterations, const std::string& scale) {
   const int h = flow.h, wd = flow.w;
-  const View input{&b.input, 0, kRefineInput, h, wd};
-  const View constant_out{&b.constant_out, 0, 128, h, wd};
-  r.conv(w.conv1_constant, View{&b.constant_in, 0, kContext + 1, h, wd}, 1, 1, kNone, constant_out);
-  r.zero(input.channels(kHiddenOffset, kHidden));
-  r.copy(flow, input.channels(kFlowOffset, 2));
+  const View input{&b.input, 0, kRefineDynamicChannels, h, wd};
+  const View constant_out{&b.constant_out, 0, kRefineHiddenWidth, h, wd};
+  r.conv(w.conv1_constant, View{&b.constant_in, 0, kRefineConstantChannels, h, wd}, 1, 1, kActNone, constant_out);
+  r.zero(input.channels(kRefineHiddenOffset, kHiddenChannels));
+  r.copy(flow, input.channels(kRefineFlowOffset, 2));
   const int inter = w.conv2.out_channels;
   for (int i = 0; i < iterations; ++i) {
-    struct {
-      int h, w, channels, f0_off, f1_off, flow_off, out_off;
-    } cp{h, wd, f0.c, f0.offset(), f1.offset(), flow.offset(), 0};
-    r.dispatch(Shader::local_correlation, {f0.buffer, f1.buffer, &b.input, flow.buffer}, &cp, sizeof cp,
-               groups(static_cast<long>(h) * wd, kLocal));
-    const View xa{&b.xa, 0, 128, h, wd};
-    r.conv(w.conv1_dynamic, input, 1, 1, kLeakyRelu, xa, &constant_out);
+    const LocalCorrelationParams cp{h, wd, f0.c, f0.offset(), f1.offset(), flow.offset(), 0};
+    r.dispatch<Shader::local_correlation>({f0.buffer, f1.buffer, &b.input, flow.buffer}, cp,
+                                          groups(static_cast<long>(h) * wd, kLocal));
+    const View xa{&b.xa, 0, kRefineHiddenWidth, h, wd};
+    r.conv(w.conv1_dynamic, input, 1, 1, kActLeakyRelu, xa, &constant_out);
     View x{&b.xb, 0, inter, h, wd}, y{&b.xa, 0, inter, h, wd};
-    r.conv(w.conv2, xa, 1, 1, kLeakyRelu, x);
+    r.conv(w.conv2, xa, 1, 1, kActLeakyRelu, x);
     for (const auto& layer : w.conv_layers) {
-      r.conv(layer, x, 1, 1, kLeakyRelu, y);
+      r.conv(layer, x, 1, 1, kActLeakyRelu, y);
       std::swap(x, y);
     }
-    const View out66{&b.out66, 0, 66, h, wd};
-    r.conv(w.conv3, x, 1, 1, kNone, out66);
-    struct {
-      int plane, hidden_off, flow_in_off, flow_off;
-    } up{h * wd, input.channels(kHiddenOffset, 1).offset(), input.channels(kFlowOffset, 1).offset(), flow.offset()};
-    r.dispatch(Shader::refine_update, {&b.out66, nullptr, &b.input, flow.buffer}, &up, sizeof up,
-               groups(static_cast<long>(h) * wd, kLocal));
+    const View out66{&b.out66, 0, kRefineOutputChannels, h, wd};
+    r.conv(w.conv3, x, 1, 1, kActNone, out66);
+    const RefineUpdateParams up{h * wd, input.channels(kRefineHiddenOffset, 1).offset(),
+                                input.channels(kRefineFlowOffset, 1).offset(), flow.offset()};
+    r.dispatch<Shader::refine_update>({&b.out66, nullptr, &b.input, flow.buffer}, up,
+                                      groups(static_cast<long>(h) * wd, kLocal));
     const std::string it = "_iter" + std::to_string(i);
     if (!r.observing()) {
       r.mark("refine_" + scale + it);  // the observer's three tensors of an iteration are read at its end
     } else {
-      r.observe("corr_" + scale + it, 0, input.channels(0, kCorr));
-      r.observe("refine_" + scale + it + "_hidden", 0, input.channels(kHiddenOffset, kHidden));
+      r.observe("corr_" + scale + it, 0, input.channels(0, kCorrChannels));
+      r.observe("refine_" + scale + it + "_hidden", 0, input.channels(kRefineHiddenOffset, kHiddenChannels));
       r.observe("refine_" + scale + it + "_delta", 0, out66.channels(0, 2));
     }
   }
@@ -722,10 +701,10 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   const Slot& s1 = slots_[static_cast<std::size_t>(slot1)];
   const auto& wt = *weights_;
   const int l = tokens_;
-  r.observe("backbone_s16", 0, View{&s0.f16, 0, 192, h16_, w16_});
-  r.observe("backbone_s16", 1, View{&s1.f16, 0, 192, h16_, w16_});
-  r.observe("backbone_s8", 0, View{&s0.f8, 0, 192, h8_, w8_});
-  r.observe("backbone_s8", 1, View{&s1.f8, 0, 192, h8_, w8_});
+  r.observe("backbone_s16", 0, View{&s0.f16, 0, kFeatureChannels, h16_, w16_});
+  r.observe("backbone_s16", 1, View{&s1.f16, 0, kFeatureChannels, h16_, w16_});
+  r.observe("backbone_s8", 0, View{&s0.f8, 0, kFeatureChannels, h8_, w8_});
+  r.observe("backbone_s8", 1, View{&s1.f8, 0, kFeatureChannels, h8_, w8_});
   r.observe("conv_s8", 0, View{&s0.up, 0, 128, h8_, w8_});
 
   // 1/16: cross-attention (layer 1 reads layer 0's outputs of both frames), then its BatchNorm.
@@ -734,34 +713,30 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   record_attention_layer(r, wt.attention[1], state0_, state1_, attended_[0]);
   record_attention_layer(r, wt.attention[1], state1_, state0_, attended_[1]);
   for (const auto& a : attended_) {
-    struct {
-      int channels, plane, x_off, scale_off, shift_off;
-    } p{kDim, l, 0, wt.attention_norm_scale, wt.attention_norm_shift};
-    r.dispatch(Shader::channel_affine, {&wt.buffer, nullptr, &a, nullptr}, &p, sizeof p, groups(kDim * l, kLocal));
+    const ChannelAffineParams p{kDim, l, 0, wt.attention_norm_scale, wt.attention_norm_shift};
+    r.dispatch<Shader::channel_affine>({&wt.buffer, nullptr, &a, nullptr}, p, groups(kDim * l, kLocal));
   }
   const View att0{&attended_[0], 0, kDim, h16_, w16_}, att1{&attended_[1], 0, kDim, h16_, w16_};
   r.observe("cross_attn_s16", 0, att0);
   r.observe("cross_attn_s16", 1, att1);
 
   // Global matching: softmax(F0 F1^T / sqrt(128)) G - G, in blocks of rows.
-  const View feat0 = att0.channels(kContext, kFeatures), feat1 = att1.channels(kContext, kFeatures);
-  const float alpha = 1.f / std::sqrt(static_cast<float>(kFeatures));
+  const View feat0 = att0.channels(kContextChannels, kMatchingChannels), feat1 = att1.channels(kContextChannels, kMatchingChannels);
+  const float alpha = 1.f / std::sqrt(static_cast<float>(kMatchingChannels));
   for (int r0 = 0; r0 < l; r0 += block_rows_) {
     const int n = std::min(block_rows_, l - r0);
     r.matmul(attended_[0], attended_[1], scores_,
-             {n, l, kFeatures, feat0.offset() + r0, 1, l, feat1.offset(), l, 1, 0, l, 1, -1, kNone, alpha});
-    struct {
-      int rows, cols, off;
-    } sp{n, l, 0};
-    r.dispatch(Shader::softmax_rows, {nullptr, nullptr, &scores_, nullptr}, &sp, sizeof sp, static_cast<uint32_t>(n));
-    r.matmul(grid_, scores_, correspondence_, {2, n, l, 0, l, 1, 0, 1, l, r0, l, 1, -1, kNone, 1.f});
+             {n, l, kMatchingChannels, feat0.offset() + r0, 1, l, feat1.offset(), l, 1, 0, l, 1, -1, kActNone, alpha});
+    r.dispatch<Shader::softmax_rows>({nullptr, nullptr, &scores_, nullptr}, SoftmaxRowsParams{n, l, 0},
+                                     static_cast<uint32_t>(n));
+    r.matmul(grid_, scores_, correspondence_, {2, n, l, 0, l, 1, 0, 1, l, r0, l, 1, -1, kActNone, 1.f});
   }
   const View flow16{&flow16_, 0, 2, h16_, w16_};
   r.axpby(1.f, View{&correspondence_, 0, 2, h16_, w16_}, -1.f, View{&grid_, 0, 2, h16_, w16_}, flow16);
   r.observe("global_matching_flow", 0, flow16);
 
   // 1/16 refinement with ctx16 = relu(context of frame 0).
-  r.resample(att0.channels(0, kContext), View{&refine16_.constant_in, 0, kContext, h16_, w16_}, 1, true, 1.f);
+  r.resample(att0.channels(0, kContextChannels), View{&refine16_.constant_in, 0, kContextChannels, h16_, w16_}, 1, true, 1.f);
   record_refinement(r, wt.refine_s16, refine16_, feat0, feat1, flow16, iterations.s16, "s16");
 
   // 1/16 → 1/8.
@@ -769,41 +744,38 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   r.resample(flow16, flow8, 2, false, 2.f);
   const std::array<const Slot*, 2> frames{&s0, &s1};
   for (int f = 0; f < 2; ++f) {
-    const View in{&feature_in_, 0, 256, h8_, w8_};
-    r.copy(View{&frames[f]->f8, kContext, kFeatures, h8_, w8_}, in.channels(0, kFeatures));
-    r.resample(View{&attended_[f], kContext, kFeatures, h16_, w16_}, in.channels(kFeatures, kFeatures), 2, false, 1.f);
-    const View tmp{&merge_tmp_, 0, 128, h8_, w8_};
-    r.conv(wt.merge_s8_0, in, 1, 1, kGelu, tmp);
-    r.conv(wt.merge_s8_2, tmp, 1, 1, kNone, View{&features8_[f], 0, 128, h8_, w8_});
+    const View in{&feature_in_, 0, 2 * kMatchingChannels, h8_, w8_};
+    r.copy(View{&frames[f]->f8, kContextChannels, kMatchingChannels, h8_, w8_}, in.channels(0, kMatchingChannels));
+    r.resample(View{&attended_[f], kContextChannels, kMatchingChannels, h16_, w16_}, in.channels(kMatchingChannels, kMatchingChannels), 2, false, 1.f);
+    const View tmp{&merge_tmp_, 0, kMatchingChannels, h8_, w8_};
+    r.conv(wt.merge_s8_0, in, 1, 1, kActGelu, tmp);
+    r.conv(wt.merge_s8_2, tmp, 1, 1, kActNone, View{&features8_[f], 0, kMatchingChannels, h8_, w8_});
   }
-  r.observe("merge_s8", 0, View{&features8_[0], 0, 128, h8_, w8_});
-  r.observe("merge_s8", 1, View{&features8_[1], 0, 128, h8_, w8_});
-  const View ctx_in{&context_in_, 0, 128, h8_, w8_};
-  r.resample(View{&s0.f8, 0, kContext, h8_, w8_}, ctx_in.channels(0, kContext), 1, true, 1.f);
-  r.resample(att0.channels(0, kContext), ctx_in.channels(kContext, kContext), 2, true, 1.f);
-  const View ctx_tmp{&context_tmp_, 0, 64, h8_, w8_};
-  r.conv(wt.context_merge_s8_0, ctx_in, 1, 1, kGelu, ctx_tmp);
-  const View ctx8{&refine8_.constant_in, 0, kContext, h8_, w8_};
-  r.conv(wt.context_merge_s8_2, ctx_tmp, 1, 1, kNone, ctx8);
+  r.observe("merge_s8", 0, View{&features8_[0], 0, kMatchingChannels, h8_, w8_});
+  r.observe("merge_s8", 1, View{&features8_[1], 0, kMatchingChannels, h8_, w8_});
+  const View ctx_in{&context_in_, 0, 2 * kContextChannels, h8_, w8_};
+  r.resample(View{&s0.f8, 0, kContextChannels, h8_, w8_}, ctx_in.channels(0, kContextChannels), 1, true, 1.f);
+  r.resample(att0.channels(0, kContextChannels), ctx_in.channels(kContextChannels, kContextChannels), 2, true, 1.f);
+  const View ctx_tmp{&context_tmp_, 0, kContextChannels, h8_, w8_};
+  r.conv(wt.context_merge_s8_0, ctx_in, 1, 1, kActGelu, ctx_tmp);
+  const View ctx8{&refine8_.constant_in, 0, kContextChannels, h8_, w8_};
+  r.conv(wt.context_merge_s8_2, ctx_tmp, 1, 1, kActNone, ctx8);
   r.observe("context_merge_s8", 0, ctx8);
 
   // 1/8 refinement.
-  record_refinement(r, wt.refine_s8, refine8_, View{&features8_[0], 0, 128, h8_, w8_},
-                    View{&features8_[1], 0, 128, h8_, w8_}, flow8, iterations.s8, "s8");
+  record_refinement(r, wt.refine_s8, refine8_, View{&features8_[0], 0, kMatchingChannels, h8_, w8_},
+                    View{&features8_[1], 0, kMatchingChannels, h8_, w8_}, flow8, iterations.s8, "s8");
 
   // Convex upsampling.
   const View up_in{&upsample_in_, 0, 130, h8_, w8_};
   r.copy(flow8, up_in.channels(0, 2));
   r.copy(View{&s0.up, 0, 128, h8_, w8_}, up_in.channels(2, 128));
-  const View u1{&upsample1_, 0, 256, h8_, w8_}, u2{&upsample2_, 0, 512, h8_, w8_}, mask{&mask_, 0, 576, h8_, w8_};
-  r.conv(wt.upsample_conv1, up_in, 1, 1, kRelu, u1);
-  r.conv(wt.upsample_conv2, u1, 1, 1, kRelu, u2);
-  r.conv(wt.upsample_conv3, u2, 1, 0, kNone, mask);
-  struct {
-    int h8, w8;
-  } cp{h8_, w8_};
-  r.dispatch(Shader::convex_upsample, {&mask_, &flow8_, &flow_full_, nullptr}, &cp, sizeof cp,
-             groups(static_cast<long>(height_) * width_, kLocal));
+  const View u1{&upsample1_, 0, 256, h8_, w8_}, u2{&upsample2_, 0, 512, h8_, w8_}, mask{&mask_, 0, kUpsampleMaskChannels, h8_, w8_};
+  r.conv(wt.upsample_conv1, up_in, 1, 1, kActRelu, u1);
+  r.conv(wt.upsample_conv2, u1, 1, 1, kActRelu, u2);
+  r.conv(wt.upsample_conv3, u2, 1, 0, kActNone, mask);
+  r.dispatch<Shader::convex_upsample>({&mask_, &flow8_, &flow_full_, nullptr}, ConvexUpsampleParams{h8_, w8_},
+                                      groups(static_cast<long>(height_) * width_, kLocal));
   r.copy_raw(flow_full_, r.readback(), static_cast<std::size_t>(2) * height_ * width_);
   r.host_barrier();
   r.mark("flow");

@@ -24,6 +24,7 @@
 
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
+#include "inference_backend.hpp"
 #include "tensor.hpp"
 #include "vulkan/device_weights.hpp"
 
@@ -41,7 +42,7 @@ struct View {
 
 class VulkanNetwork {
  public:
-  static constexpr int kSlots = 3;  // frame features kept on the device (see InferenceBackend)
+  static constexpr int kSlots = InferenceBackend::kSlots;  // frame features kept on the device
 
   // height, width: multiples of 16, at least 32. Throws BackendError (e.g. out of memory).
   VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width);

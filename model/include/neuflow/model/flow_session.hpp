@@ -12,20 +12,11 @@
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/gpu_devices.hpp"
+#include "neuflow/model/image_view.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
 
 namespace neuflow::model {
-
-// An 8-bit, 3-channel interleaved image; `stride` is the number of bytes between rows and
-// `order` the order its pixels hold (the session feeds the network SessionOptions::network_order).
-struct ImageView {
-  const std::uint8_t* data = nullptr;
-  int width = 0;
-  int height = 0;
-  std::ptrdiff_t stride = 0;
-  ChannelOrder order = ChannelOrder::rgb;
-};
 
 class FlowSession {
  public:

@@ -3,7 +3,7 @@
 // of the convolutions and matrix products this implementation performs. The reference
 // additionally builds the all-pairs 1/8 correlation volume ((HW/64)² · 256 FLOP), which the
 // network doc's cost table includes and this core never computes.
-#include "neuflow/model/flow_session.hpp"
+#include "neuflow/model/session_settings.hpp"
 
 namespace neuflow::model {
 

@@ -2,13 +2,11 @@
 // NeuFlow-V2's local correlation, computed from the features directly instead of sampling an
 // all-pairs volume: per pixel, dot products with the 10×10 integer neighbours of
 // floor(p + flow), blended with the shared bilinear weights into the 9×9 window.
+#include "network_dims.hpp"
 #include "ops/feature_ops.hpp"
 #include "tensor.hpp"
 
 namespace neuflow::model {
-
-inline constexpr int kCorrRadius = 4;
-inline constexpr int kCorrWindow = 2 * kCorrRadius + 1;  // 9
 
 // Writes 81 channels per pixel into `out` starting at channel out_offset; channel i*9 + j
 // holds the correlation at offset (dx = i - 4, dy = j - 4), scaled by 1/sqrt(channels).

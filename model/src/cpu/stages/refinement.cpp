@@ -8,8 +8,6 @@
 namespace neuflow::model {
 
 namespace {
-constexpr int kHiddenOffset = kCorrChannels;
-constexpr int kFlowOffset = kCorrChannels + kHiddenChannels;
 constexpr float kHiddenClamp = 4.f;
 }  // namespace
 
@@ -51,14 +49,14 @@ void Refinement::begin(dnnl::stream& stream, const Tensor& context) {
   for (std::size_t p = 0; p < constant_.pixels(); ++p) constant_.data[p * constant_.c + kContextChannels] = kCorrRadiusPlane;
   conv1_constant_->run(stream, wrap_nhwc(constant_));
   for (std::size_t p = 0; p < input_.pixels(); ++p) {
-    std::fill_n(input_.data.data() + p * input_.c + kHiddenOffset, kHiddenChannels, 0.f);
+    std::fill_n(input_.data.data() + p * input_.c + kRefineHiddenOffset, kHiddenChannels, 0.f);
   }
   stream.wait();
 }
 
 void Refinement::step(dnnl::stream& stream, const ChannelSlice& f0, const ChannelSlice& f1, Tensor& flow) {
   local_correlation(f0, f1, flow, input_, 0);
-  copy_channels(all_channels(flow), input_, kFlowOffset);
+  copy_channels(all_channels(flow), input_, kRefineFlowOffset);
 
   const auto& x1 = conv1_->run(stream, wrap_nhwc(input_), &conv1_constant_->output());
   const dnnl::memory* x = &conv2_->run(stream, x1);
@@ -70,14 +68,14 @@ void Refinement::step(dnnl::stream& stream, const ChannelSlice& f0, const Channe
 #pragma omp parallel for
   for (int p = 0; p < hw; ++p) {
     const float* o = output_.data.data() + static_cast<std::size_t>(p) * output_.c;
-    float* hidden = input_.data.data() + static_cast<std::size_t>(p) * input_.c + kHiddenOffset;
+    float* hidden = input_.data.data() + static_cast<std::size_t>(p) * input_.c + kRefineHiddenOffset;
     for (int c = 0; c < kHiddenChannels; ++c) hidden[c] = std::clamp(o[2 + c], -kHiddenClamp, kHiddenClamp);
     flow.data[2 * p] += o[0];
     flow.data[2 * p + 1] += o[1];
   }
 }
 
-Tensor Refinement::hidden() const { return extract_channels({&input_, kHiddenOffset, kHiddenChannels}); }
+Tensor Refinement::hidden() const { return extract_channels({&input_, kRefineHiddenOffset, kHiddenChannels}); }
 
 Tensor Refinement::delta() const { return extract_channels({&output_, 0, 2}); }
 

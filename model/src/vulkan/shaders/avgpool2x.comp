@@ -5,7 +5,7 @@
 #include "common.glsl"
 layout(std430, binding = 0) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
-layout(push_constant) uniform Params { int channels, in_h, in_w; } p;
+#include "params/avgpool2x_params.h"
 
 void main() {
   const int oh = p.in_h / 2, ow = p.in_w / 2;

@@ -6,7 +6,7 @@
 layout(std430, binding = 0) readonly buffer X { VALUE x[]; };
 layout(std430, binding = 1) readonly buffer Y { VALUE y[]; };
 layout(std430, binding = 2) buffer Out { VALUE dst[]; };
-layout(push_constant) uniform Params { int count, x_off, y_off, out_off; float a, b; } p;
+#include "params/axpby_params.h"
 
 void main() {
   FOR_EACH(i, p.count) dst[p.out_off + i] = VALUE(p.a * float(x[p.x_off + i]) + p.b * float(y[p.y_off + i]));

@@ -5,7 +5,7 @@
 #include "common.glsl"
 layout(std430, binding = 0) readonly buffer W { VALUE w[]; };
 layout(std430, binding = 2) buffer X { VALUE x[]; };
-layout(push_constant) uniform Params { int channels, plane, x_off, scale_off, shift_off; } p;
+#include "params/channel_affine_params.h"
 
 void main() {
   FOR_EACH(i, p.channels * p.plane) {

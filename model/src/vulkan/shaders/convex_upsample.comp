@@ -8,7 +8,7 @@
 layout(std430, binding = 0) readonly buffer Mask { VALUE mask[]; };
 layout(std430, binding = 1) readonly buffer Flow8 { VALUE flow8[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
-layout(push_constant) uniform Params { int h8, w8; } p;
+#include "params/convex_upsample_params.h"
 
 void main() {
   const int plane8 = p.h8 * p.w8;

@@ -7,7 +7,7 @@
 #include "common.glsl"
 layout(std430, binding = 0) readonly buffer In { uint words[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
-layout(push_constant) uniform Params { int in_w, in_h, out_w, out_h, pad_left, pad_top, swap; } p;
+#include "params/frame_u8_params.h"
 
 uint byte_at(int i) { return (words[i >> 2] >> (8 * (i & 3))) & 0xffu; }
 

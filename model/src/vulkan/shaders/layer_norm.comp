@@ -8,7 +8,7 @@ layout(std430, binding = 0) readonly buffer W { VALUE w[]; };
 layout(std430, binding = 1) readonly buffer X { VALUE x[]; };
 layout(std430, binding = 2) buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer R { VALUE res[]; };
-layout(push_constant) uniform Params { int dim, tokens, x_off, out_off, res_off, gamma_off, beta_off; } p;
+#include "params/layer_norm_params.h"
 
 void main() {
   FOR_EACH(t, p.tokens) {

@@ -10,7 +10,7 @@ layout(std430, binding = 0) readonly buffer F0 { VALUE f0[]; };
 layout(std430, binding = 1) readonly buffer F1 { VALUE f1[]; };
 layout(std430, binding = 2) buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Flow { VALUE flow[]; };
-layout(push_constant) uniform Params { int h, w, channels, f0_off, f1_off, flow_off, out_off; } p;
+#include "params/local_correlation_params.h"
 
 const int R = 4, WIN = 9, N = 10;
 

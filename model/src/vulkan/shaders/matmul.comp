@@ -17,25 +17,9 @@ layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
 layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend
 
 #ifdef IMPLICIT_CONV
-layout(push_constant) uniform Params {
-  int in_c, in_h, in_w, in_off;   // B: planar input, channel 0 at in_off (binding 1)
-  int out_c, out_h, out_w, out_off;  // C: planar output, channel 0 at out_off
-  int kernel, stride, pad, act;
-  int w_off;    // A: weights at w_off in binding 0
-  int bias_off; // in binding 0 (with the weights), < 0: none
-  int add_off;  // addend in binding 3, < 0: none
-  float alpha;
-} p;
+#include "params/conv2d_params.h"
 #else
-layout(push_constant) uniform Params {
-  int m, n, k;
-  int a_off, a_rs, a_cs;
-  int b_off, b_rs, b_cs;
-  int c_off, c_rs, c_cs;
-  int bias_off;  // per row of C, in binding 0 (with A); < 0: none
-  int act;
-  float alpha;
-} p;
+#include "params/matmul_params.h"
 #endif
 
 const int BM = 64, BN = 64, BK = 16;
@@ -52,9 +36,9 @@ float erf_approx(float x) {
 }
 
 float activate(float v, int act) {
-  if (act == 1) return v > 0.0 ? v : 0.1 * v;          // LeakyReLU(0.1)
-  if (act == 2) return max(v, 0.0);                     // ReLU
-  if (act == 3) return 0.5 * v * (1.0 + erf_approx(v * 0.70710678118654752)); // exact GELU
+  if (act == kActLeakyRelu) return v > 0.0 ? v : 0.1 * v;          // LeakyReLU(0.1)
+  if (act == kActRelu) return max(v, 0.0);                     // ReLU
+  if (act == kActGelu) return 0.5 * v * (1.0 + erf_approx(v * 0.70710678118654752)); // exact GELU
   return v;
 }
 

@@ -8,7 +8,7 @@
 layout(std430, binding = 0) readonly buffer Conv3 { VALUE o[]; };
 layout(std430, binding = 2) buffer Input { VALUE input_data[]; };
 layout(std430, binding = 3) buffer Flow { VALUE flow[]; };
-layout(push_constant) uniform Params { int plane, hidden_off, flow_in_off, flow_off; } p;
+#include "params/refine_update_params.h"
 
 void main() {
   FOR_EACH(pix, p.plane) {

@@ -6,10 +6,7 @@
 #include "common.glsl"
 layout(std430, binding = 0) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) buffer Out { VALUE dst[]; };
-layout(push_constant) uniform Params {
-  int channels, in_h, in_w, in_off, out_off, factor, relu;
-  float scale;
-} p;
+#include "params/resample_params.h"
 
 void main() {
   const int oh = p.in_h * p.factor, ow = p.in_w * p.factor;

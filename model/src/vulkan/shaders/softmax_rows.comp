@@ -4,7 +4,7 @@
 // In place: each row of a [rows][cols] matrix becomes its softmax. One workgroup per row.
 layout(local_size_x = 256) in;
 layout(std430, binding = 2) buffer Data { VALUE data[]; };
-layout(push_constant) uniform Params { int rows, cols, off; } p;
+#include "params/softmax_rows_params.h"
 shared float partial[256];
 
 void main() {

@@ -1,0 +1,12 @@
+// layer_norm.comp: LayerNorm over each token of a [dim][tokens] list, plus an optional residual.
+#ifndef NEUFLOW_SHADER_LAYER_NORM_PARAMS_H
+#define NEUFLOW_SHADER_LAYER_NORM_PARAMS_H
+#include "interface.h"
+
+NEUFLOW_PUSH_CONSTANTS(LayerNormParams)
+  int dim, tokens, x_off, out_off;
+  int res_off;  // < 0: no residual
+  int gamma_off, beta_off;
+NEUFLOW_PUSH_CONSTANTS_END
+
+#endif
