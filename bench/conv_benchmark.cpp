@@ -11,8 +11,8 @@
 // model pixel, for both ways of computing the convolutions.
 //
 //   neuflow-bench-conv [--size 768x432] [--threads 2] [--runs 10] [--arena [--model CKPT]]
-#include <oneapi/dnnl/dnnl.h>
 #include <omp.h>
+#include <oneapi/dnnl/dnnl.h>
 
 #include <algorithm>
 #include <chrono>
@@ -27,9 +27,9 @@
 #include "dnnl/context.hpp"
 #include "dnnl/conv_op.hpp"
 #include "network.hpp"
-#include "winograd/winograd_conv.hpp"
 #include "neuflow/model/architecture.hpp"
 #include "neuflow/model/flow_model.hpp"
+#include "winograd/winograd_conv.hpp"
 
 namespace {
 
@@ -51,7 +51,8 @@ double best_seconds(int runs, F&& f) {
 double sgemm_peak_gflops(int runs) {
   const int n = 2048;
   std::vector<float> a(static_cast<std::size_t>(n) * n, 1.f), b(a.size(), 0.5f), c(a.size());
-  const double s = best_seconds(runs, [&] { dnnl_sgemm('N', 'N', n, n, n, 1.f, a.data(), n, b.data(), n, 0.f, c.data(), n); });
+  const double s =
+      best_seconds(runs, [&] { dnnl_sgemm('N', 'N', n, n, n, 1.f, a.data(), n, b.data(), n, 0.f, c.data(), n); });
   return 2.0 * n * n * n / s / 1e9;
 }
 
@@ -114,11 +115,26 @@ int main(int argc, char** argv) {
   std::string model = std::string(shared_env && *shared_env ? shared_env : NEUFLOW_DEFAULT_SHARED_DIR) +
                       "/fixtures/neuflow-v2-seed0/checkpoint.pth";
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--arena")) { arena = true; continue; }
-    if (i + 1 < argc && !std::strcmp(argv[i], "--size") && std::sscanf(argv[i + 1], "%dx%d", &width, &height) == 2) { ++i; continue; }
-    if (i + 1 < argc && !std::strcmp(argv[i], "--threads")) { threads = std::stoi(argv[++i]); continue; }
-    if (i + 1 < argc && !std::strcmp(argv[i], "--runs")) { runs = std::stoi(argv[++i]); continue; }
-    if (i + 1 < argc && !std::strcmp(argv[i], "--model")) { model = argv[++i]; continue; }
+    if (!std::strcmp(argv[i], "--arena")) {
+      arena = true;
+      continue;
+    }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--size") && std::sscanf(argv[i + 1], "%dx%d", &width, &height) == 2) {
+      ++i;
+      continue;
+    }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--threads")) {
+      threads = std::stoi(argv[++i]);
+      continue;
+    }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--runs")) {
+      runs = std::stoi(argv[++i]);
+      continue;
+    }
+    if (i + 1 < argc && !std::strcmp(argv[i], "--model")) {
+      model = argv[++i];
+      continue;
+    }
     std::fprintf(stderr, "usage: neuflow-bench-conv [--size WxH] [--threads N] [--runs N] [--arena [--model CKPT]]\n");
     return 64;
   }
@@ -134,7 +150,8 @@ int main(int argc, char** argv) {
   for (const auto& l : neuflow_v2_layers()) {
     if (l.kind == LayerKind::conv && l.kernel == 3) layers.push_back({l.name, l.in, l.out, l.scale});
     // The backbone's 6×6 stride-2 convolution on 192 channels, by space-to-depth.
-    if (l.kind == LayerKind::conv && l.kernel == 6 && l.in % 8 == 0) layers.push_back({l.name, l.in, l.out, l.scale, 2});
+    if (l.kind == LayerKind::conv && l.kernel == 6 && l.in % 8 == 0)
+      layers.push_back({l.name, l.in, l.out, l.scale, 2});
   }
   // The refinements' first convolution runs as two: the per-iteration inputs and the per-pair constant ones.
   layers.push_back({"refine_s8.conv1 (per iteration)", 147, 128, 8});
@@ -152,7 +169,8 @@ int main(int argc, char** argv) {
     // The plan's choice: F(6×6) only on the 1/8 refinement's layers (ConvParams::repeated).
     const bool repeated = l.name.rfind("refine_s8", 0) == 0 && l.name != "refine_s8.conv1.conv" &&
                           l.name.find("(per pair)") == std::string::npos;
-    const bool six = repeated && WinogradConv::faster_tile(l.in * l.stride * l.stride, l.out, h, w) == WinogradTile::f6x6;
+    const bool six =
+        repeated && WinogradConv::faster_tile(l.in * l.stride * l.stride, l.out, h, w) == WinogradTile::f6x6;
     const double wino = six ? wino6 : wino4;
     const double flops = 2.0 * h * w * l.in * l.out * k * k;
     char hw[32];

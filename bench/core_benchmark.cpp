@@ -18,8 +18,8 @@
 //
 // Peak RSS is per process: run one size per process for per-size peaks (bench/run-core.sh).
 #include <benchmark/benchmark.h>
-#include <oneapi/dnnl/dnnl.h>
 #include <omp.h>
+#include <oneapi/dnnl/dnnl.h>
 #include <sys/resource.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -119,7 +119,8 @@ class FrameSequence {
       frame.create(height_, width_, CV_8UC3);
       const int shift = static_cast<int>(3 * (i % kGradientFrames));
       for (int y = 0; y < height_; ++y)
-        for (int x = 0; x < width_; ++x) frame.at<cv::Vec3b>(y, x) = cv::Vec3b((x + shift) & 255, y & 255, (x ^ y) & 255);
+        for (int x = 0; x < width_; ++x)
+          frame.at<cv::Vec3b>(y, x) = cv::Vec3b((x + shift) & 255, y & 255, (x ^ y) & 255);
       return frame;
     }
     const cv::Mat decoded = cv::imdecode(encoded_[i % encoded_.size()], cv::IMREAD_COLOR);
@@ -189,7 +190,8 @@ void compare(benchmark::State& state, const std::string& key, const Variant& v, 
   if (v.backend == neuflow::model::Backend::vulkan) {
     if (!is_fp16(v)) {
       g_vulkan_fp32_ms[gpu_key] = state.counters["ms"];
-    } else if (const auto it = g_vulkan_fp32_ms.find(gpu_key); it != g_vulkan_fp32_ms.end() && state.counters["ms"] > 0) {
+    } else if (const auto it = g_vulkan_fp32_ms.find(gpu_key);
+               it != g_vulkan_fp32_ms.end() && state.counters["ms"] > 0) {
       state.counters["fp32_ms"] = it->second;
       state.counters["x_fp32"] = it->second / state.counters["ms"];
     }
@@ -249,8 +251,8 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
          neuflow::model::network_cost(height, width).stream_frame());
   compare(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), variant);
   if (variant.backend == neuflow::model::Backend::vulkan) {
-    g_vulkan_push_ms[std::string(neuflow::model::precision_name(variant.precision)) + "/" + std::to_string(width) + "x" +
-                     std::to_string(height)] = state.counters["ms"];
+    g_vulkan_push_ms[std::string(neuflow::model::precision_name(variant.precision)) + "/" + std::to_string(width) +
+                     "x" + std::to_string(height)] = state.counters["ms"];
   }
 }
 
@@ -432,8 +434,10 @@ int main(int argc, char** argv) {
   }
   if (take_option(argc, argv, "--backend", value)) {
     if (value != "cpu" && value != "vulkan") {
-      std::fprintf(stderr, "neuflow-bench-core: --backend wants cpu or vulkan (vulkan also runs the CPU, to compare), got '%s'\n",
-                   value.c_str());
+      std::fprintf(
+          stderr,
+          "neuflow-bench-core: --backend wants cpu or vulkan (vulkan also runs the CPU, to compare), got '%s'\n",
+          value.c_str());
       return 64;
     }
     g_config.vulkan = value == "vulkan";
@@ -449,7 +453,8 @@ int main(int argc, char** argv) {
       const std::size_t comma = std::min(value.find(',', pos), value.size());
       const auto precision = neuflow::model::parse_precision(value.substr(pos, comma - pos));
       if (!precision) {
-        std::fprintf(stderr, "neuflow-bench-core: --precision wants fp32, fp16 or fp32,fp16, got '%s'\n", value.c_str());
+        std::fprintf(stderr, "neuflow-bench-core: --precision wants fp32, fp16 or fp32,fp16, got '%s'\n",
+                     value.c_str());
         return 64;
       }
       g_config.precisions.push_back(*precision);
@@ -457,7 +462,8 @@ int main(int argc, char** argv) {
     }
     // fp32 first, so that each fp16 benchmark finds the fp32 time it is set against.
     std::sort(g_config.precisions.begin(), g_config.precisions.end());
-    g_config.precisions.erase(std::unique(g_config.precisions.begin(), g_config.precisions.end()), g_config.precisions.end());
+    g_config.precisions.erase(std::unique(g_config.precisions.begin(), g_config.precisions.end()),
+                              g_config.precisions.end());
   }
   if (take_option(argc, argv, "--sizes", value)) {
     g_config.sizes.clear();
@@ -479,7 +485,10 @@ int main(int argc, char** argv) {
     return 66;
   }
 
-  benchmark::RegisterBenchmark("sgemm_peak/2048", BM_SgemmPeak)->Arg(2048)->Iterations(8)->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("sgemm_peak/2048", BM_SgemmPeak)
+      ->Arg(2048)
+      ->Iterations(8)
+      ->Unit(benchmark::kMillisecond);
   for (const auto& [w, h] : g_config.sizes) {
     const std::string size = std::to_string(w) + "x" + std::to_string(h);
     using neuflow::model::Backend;

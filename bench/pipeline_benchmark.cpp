@@ -37,8 +37,9 @@ double core_seconds_per_frame(const std::string& model, int w, int h, int thread
 double pipeline_seconds_per_frame(const std::string& model, int w, int h, int threads, int frames) {
   const std::string description = "videotestsrc num-buffers=" + std::to_string(frames + 1) +
                                   " pattern=ball ! video/x-raw,format=RGB,width=" + std::to_string(w) +
-                                  ",height=" + std::to_string(h) + " ! neuflow name=nf behaviour=every-pair threads=" +
-                                  std::to_string(threads) + " model=" + model + " ! fakesink name=sink sync=false";
+                                  ",height=" + std::to_string(h) +
+                                  " ! neuflow name=nf behaviour=every-pair threads=" + std::to_string(threads) +
+                                  " model=" + model + " ! fakesink name=sink sync=false";
   GError* err = nullptr;
   GstElement* pipeline = gst_parse_launch(description.c_str(), &err);
   if (!pipeline || err) {
@@ -87,10 +88,14 @@ int main(int argc, char** argv) {
                       "/fixtures/neuflow-v2-seed0/checkpoint.pth";
   int threads = 2, w = 768, h = 432, frames = 8;
   for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--model")) model = argv[i + 1];
-    else if (!std::strcmp(argv[i], "--threads")) threads = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--frames")) frames = std::atoi(argv[i + 1]);
-    else if (!std::strcmp(argv[i], "--size")) std::sscanf(argv[i + 1], "%dx%d", &w, &h);
+    if (!std::strcmp(argv[i], "--model"))
+      model = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--threads"))
+      threads = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--frames"))
+      frames = std::atoi(argv[i + 1]);
+    else if (!std::strcmp(argv[i], "--size"))
+      std::sscanf(argv[i + 1], "%dx%d", &w, &h);
     else {
       std::fprintf(stderr, "usage: neuflow-bench-pipeline [--model CKPT] [--threads N] [--size WxH] [--frames N]\n");
       return 64;

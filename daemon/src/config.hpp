@@ -45,17 +45,17 @@ struct SourceConfig {
 // The neuflow element's properties, under the same names in the file (the graph's FlowStage:
 // flow_stage()).
 struct FlowConfig {
-  std::filesystem::path model;   // model = "/var/lib/neuflow/neuflow_mixed.pth" (required)
+  std::filesystem::path model;              // model = "/var/lib/neuflow/neuflow_mixed.pth" (required)
   int iters_s16 = model::Iterations{}.s16;  // iters-s16
   int iters_s8 = model::Iterations{}.s8;    // iters-s8
-  int model_width = 0;           // model-width / model-height: 0 = the frames' own size
+  int model_width = 0;                      // model-width / model-height: 0 = the frames' own size
   int model_height = 0;
-  int threads = 0;               // 0: an equal share of [daemon] threads
-  std::string behaviour = "auto";      // auto | live | every-pair
-  std::string channel_order = "rgb";   // rgb | bgr
-  std::string backend = "auto";        // auto | cpu | vulkan
-  int device = -1;                     // Vulkan device index; -1: the first GPU
-  std::string precision = "fp32";      // fp32 | fp16
+  int threads = 0;                    // 0: an equal share of [daemon] threads
+  std::string behaviour = "auto";     // auto | live | every-pair
+  std::string channel_order = "rgb";  // rgb | bgr
+  std::string backend = "auto";       // auto | cpu | vulkan
+  int device = -1;                    // Vulkan device index; -1: the first GPU
+  std::string precision = "fp32";     // fp32 | fp16
   SourcePosition where;
   bool operator==(const FlowConfig&) const = default;
 };
@@ -70,7 +70,7 @@ using pipeline::VideoSink;
 using SinkSettings = pipeline::SinkDescription;
 
 struct SinkConfig {
-  std::string name;       // `name = "..."`, default "<type>-<index>"; used in logs and metrics
+  std::string name;  // `name = "..."`, default "<type>-<index>"; used in logs and metrics
   SinkSettings settings;
   SourcePosition where;
   bool operator==(const SinkConfig&) const = default;
@@ -79,7 +79,7 @@ struct SinkConfig {
 // ---- streams and the whole file ------------------------------------------------------------
 
 struct StreamConfig {
-  std::string name;       // [[stream]] name = "front": unique, [A-Za-z0-9_-]+
+  std::string name;  // [[stream]] name = "front": unique, [A-Za-z0-9_-]+
   SourceConfig source;
   FlowConfig flow;
   std::vector<SinkConfig> sinks;  // at least one
@@ -87,23 +87,23 @@ struct StreamConfig {
   bool operator==(const StreamConfig&) const = default;
 };
 
-struct DaemonSettings {   // [daemon]
-  std::string log_level = "info";     // log-level: error | warning | notice | info | debug
-  int threads = 0;                    // inference threads shared by all streams; 0 = all cores
-  double restart_delay_min = 1.0;     // restart-delay-min (s): first backoff after a failure
-  double restart_delay_max = 60.0;    // restart-delay-max (s): backoff cap
-  double stop_timeout = 10.0;         // stop-timeout (s): wait for EOS to finish files on stop
-  double stall_timeout = 30.0;        // stall-timeout (s): a playing stream with no frames is restarted
+struct DaemonSettings {             // [daemon]
+  std::string log_level = "info";   // log-level: error | warning | notice | info | debug
+  int threads = 0;                  // inference threads shared by all streams; 0 = all cores
+  double restart_delay_min = 1.0;   // restart-delay-min (s): first backoff after a failure
+  double restart_delay_max = 60.0;  // restart-delay-max (s): backoff cap
+  double stop_timeout = 10.0;       // stop-timeout (s): wait for EOS to finish files on stop
+  double stall_timeout = 30.0;      // stall-timeout (s): a playing stream with no frames is restarted
   bool operator==(const DaemonSettings&) const = default;
 };
 
-struct MetricsSettings {  // [metrics]; absent: no endpoint
+struct MetricsSettings {              // [metrics]; absent: no endpoint
   std::string address = "127.0.0.1";  // listen = "127.0.0.1:9464"
   int port = 9464;
   bool operator==(const MetricsSettings&) const = default;
 };
 
-struct RtspSettings {     // [rtsp]; needed when a video sink uses `rtsp`
+struct RtspSettings {                 // [rtsp]; needed when a video sink uses `rtsp`
   std::string address = "127.0.0.1";  // listen = "127.0.0.1:8554"; "0.0.0.0:8554" for the network
   int port = 8554;
   std::filesystem::path credentials;  // credentials = "/etc/neuflow/rtsp-users": user:password lines
@@ -118,7 +118,7 @@ struct ConfigIssue {
   std::filesystem::path file;
   int line = 0;
   int column = 0;
-  std::string message;    // what is wrong and what was expected
+  std::string message;  // what is wrong and what was expected
   Severity severity = Severity::error;
   bool is_warning() const { return severity == Severity::warning; }
   std::string to_string() const;  // "FILE:LINE:COLUMN: message", "FILE:LINE:COLUMN: warning: message"
@@ -128,7 +128,7 @@ struct ConfigIssue {
 };
 
 struct Config {
-  std::filesystem::path file;         // where it was read from
+  std::filesystem::path file;  // where it was read from
   DaemonSettings daemon;
   std::optional<MetricsSettings> metrics;
   std::optional<RtspSettings> rtsp;
@@ -141,7 +141,6 @@ struct Config {
 pipeline::GraphDescription graph_description(const StreamConfig& stream, int threads);
 
 // ---- loading -------------------------------------------------------------------------------
-
 
 // Thrown by load_config with every issue found (not just the first): at least one error, and
 // the machine's warnings beside them.

@@ -53,8 +53,9 @@ void check_readable_file(const PathNeed& need, Issues& issues) {
       return report(need, issues,
                     need.path.filename() == "neuflow_mixed.pth"
                         ? "does not exist: download the published weights with `" + fetch + "`"
-                        : "does not exist: `" + fetch + "` downloads the published weights as neuflow_mixed.pth "
-                          "(point model at it), or copy a NeuFlow-V2 checkpoint here");
+                        : "does not exist: `" + fetch +
+                              "` downloads the published weights as neuflow_mixed.pth "
+                              "(point model at it), or copy a NeuFlow-V2 checkpoint here");
     }
     return report(need, issues, missing_or(error));
   }

@@ -108,8 +108,8 @@ ReadResult read_config(const toml::table& root_table, const std::filesystem::pat
     reader.allow_only(rtsp_keys);
     bool valid = read_listen(reader, r.address, r.port);
     if (auto users = reader.string("credentials")) {
-      r.credentials = context.need_path(PathNeed::Kind::readable_file, *users, "credentials",
-                                        reader.position("credentials"));
+      r.credentials =
+          context.need_path(PathNeed::Kind::readable_file, *users, "credentials", reader.position("credentials"));
     } else if (reader.has("credentials")) {
       valid = false;
     }

@@ -5,9 +5,9 @@
 #include <limits>
 #include <vector>
 
-#include "neuflow/pipeline/graph_plan.hpp"
 #include "config_read.hpp"
 #include "config_values.hpp"
+#include "neuflow/pipeline/graph_plan.hpp"
 
 namespace neuflow::daemon {
 namespace {

@@ -4,9 +4,9 @@
 #include <array>
 #include <climits>
 
-#include "neuflow/pipeline/graph_plan.hpp"
 #include "config_read.hpp"
 #include "config_values.hpp"
+#include "neuflow/pipeline/graph_plan.hpp"
 
 namespace neuflow::daemon {
 namespace {

@@ -16,10 +16,9 @@ using SessionLimits = model::SessionLimits;
 }  // namespace
 
 FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContext& context) {
-  static constexpr std::array<std::string_view, 11> keys = {"model",        "iters-s16",     "iters-s8", "model-width",
-                                                            "model-height", "threads",       "behaviour",
-                                                            "channel-order", "backend",      "device",
-                                                            "precision"};
+  static constexpr std::array<std::string_view, 11> keys = {"model",        "iters-s16", "iters-s8",  "model-width",
+                                                            "model-height", "threads",   "behaviour", "channel-order",
+                                                            "backend",      "device",    "precision"};
   static constexpr std::array<std::string_view, 2> precisions = {"fp32", "fp16"};
   static constexpr std::array<std::string_view, 3> backends = {"auto", "cpu", "vulkan"};
   static constexpr std::array<std::string_view, 3> behaviours = {"auto", "live", "every-pair"};
@@ -63,8 +62,8 @@ FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContex
   if (auto v = t.integer("device", -1, SessionLimits::max_device)) f.device = static_cast<int>(*v);
   if (auto v = t.choice("precision", precisions)) f.precision = *v;
   if (f.backend == "vulkan") {
-    context.needs.gpus.push_back({f.device, "stream '" + stream + "'",
-                                  t.position(t.has("device") ? "device" : "backend")});
+    context.needs.gpus.push_back(
+        {f.device, "stream '" + stream + "'", t.position(t.has("device") ? "device" : "backend")});
   }
   return f;
 }

@@ -21,7 +21,9 @@ constexpr guint kTickMs = 500;
 }  // namespace
 
 Daemon::Daemon(Config config, std::string log_level_override)
-    : config_(std::move(config)), log_level_override_(std::move(log_level_override)) { loop_ = g_main_loop_new(nullptr, FALSE); }
+    : config_(std::move(config)), log_level_override_(std::move(log_level_override)) {
+  loop_ = g_main_loop_new(nullptr, FALSE);
+}
 
 Daemon::~Daemon() {
   for (guint id : sources_) g_source_remove(id);
@@ -49,8 +51,8 @@ int Daemon::run() {
   sources_.push_back(g_unix_signal_add(SIGHUP, &Daemon::on_hangup, this));
   sources_.push_back(g_timeout_add(kTickMs, &Daemon::on_tick, this));
   if (auto interval = notifier_.watchdog_interval()) {
-    sources_.push_back(g_timeout_add(static_cast<guint>(std::max<long>(1, interval->count())), &Daemon::on_watchdog,
-                                     this));
+    sources_.push_back(
+        g_timeout_add(static_cast<guint>(std::max<long>(1, interval->count())), &Daemon::on_watchdog, this));
   }
   log_notice("starting " + std::to_string(config_.streams.size()) + " stream" +
              (config_.streams.size() == 1 ? "" : "s") + " from " + config_.file.string());
@@ -216,7 +218,8 @@ std::string Daemon::render_metrics() {
     m.flows = s.flows;
     m.uptime_s = s.state == StreamState::playing ? s.seconds_in_state : 0.0;
     for (const auto& sink : s.sinks) {
-      m.sinks.push_back({sink.name, sink.kind, sink.counts_flows, sink.flows_written, sink.bytes_written, sink.failures});
+      m.sinks.push_back(
+          {sink.name, sink.kind, sink.counts_flows, sink.flows_written, sink.bytes_written, sink.failures});
     }
     all.push_back(std::move(m));
   }
@@ -298,10 +301,9 @@ gboolean Daemon::on_tick(gpointer self) {
     d->notifier_.status(d->status_line());
   }
 
-  const bool all_finished =
-      !d->streams_.empty() && d->retiring_.empty() && std::all_of(d->streams_.begin(), d->streams_.end(), [](const auto& kv) {
-        return kv.second->state() == StreamState::finished;
-      });
+  const bool all_finished = !d->streams_.empty() && d->retiring_.empty() &&
+                            std::all_of(d->streams_.begin(), d->streams_.end(),
+                                        [](const auto& kv) { return kv.second->state() == StreamState::finished; });
   if (all_finished) {
     log_notice("every stream has finished its input; exiting");
     d->shutdown();
@@ -314,10 +316,9 @@ gboolean Daemon::on_watchdog(gpointer self) {
   // The main loop answered (we are in it), its tick ran lately, and no stream is stuck in a
   // state change: only then tell systemd all is well.
   const bool ticking = std::chrono::steady_clock::now() - d->last_tick_ < std::chrono::seconds(5);
-  const bool streams_ok = std::all_of(d->streams_.begin(), d->streams_.end(),
-                                      [](const auto& kv) { return kv.second->healthy(); }) &&
-                          std::all_of(d->retiring_.begin(), d->retiring_.end(),
-                                      [](const auto& s) { return s->healthy(); });
+  const bool streams_ok =
+      std::all_of(d->streams_.begin(), d->streams_.end(), [](const auto& kv) { return kv.second->healthy(); }) &&
+      std::all_of(d->retiring_.begin(), d->retiring_.end(), [](const auto& s) { return s->healthy(); });
   if (ticking && streams_ok) {
     d->notifier_.watchdog();
   } else {

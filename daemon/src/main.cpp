@@ -34,7 +34,8 @@ void keep_large_allocations_mapped() {
 // One issue as compilers print theirs: the position and message, then the line with a caret.
 void print_issue(const neuflow::daemon::ConfigIssue& issue) {
   std::fprintf(stderr, "%s\n", issue.to_string().c_str());
-  if (const std::string excerpt = issue.source_excerpt(); !excerpt.empty()) std::fprintf(stderr, "%s\n", excerpt.c_str());
+  if (const std::string excerpt = issue.source_excerpt(); !excerpt.empty())
+    std::fprintf(stderr, "%s\n", excerpt.c_str());
 }
 
 void print_issues(const neuflow::daemon::ConfigError& e) {
@@ -51,7 +52,8 @@ int main(int argc, char** argv) {
   std::string level;
   app.add_option("-c,--config", config_file, "Config file to run")->capture_default_str();
   app.add_option("--check-config", check_file,
-                 "Check FILE and exit: 78 with each error (its line, a caret under the column) when the file itself is wrong (syntax, keys, "
+                 "Check FILE and exit: 78 with each error (its line, a caret under the column) when the file itself is "
+                 "wrong (syntax, keys, "
                  "types, ranges, names), else 0; what this machine lacks now (a camera, a model, an input file, a "
                  "GStreamer element) is printed as a warning, since the daemon waits for it");
   app.add_option("--log-level", level, "error, warning, notice, info or debug; overrides [daemon] log-level");

@@ -41,8 +41,8 @@ class MetricsServer {
   MetricsServer(const MetricsServer&) = delete;
   MetricsServer& operator=(const MetricsServer&) = delete;
 
-  int port() const;              // the port actually bound
-  std::string url() const;       // "http://127.0.0.1:9464/metrics", for the log
+  int port() const;                      // the port actually bound
+  std::string url() const;               // "http://127.0.0.1:9464/metrics", for the log
   std::size_t open_connections() const;  // client connections libsoup still holds
 
   struct Impl;  // public so that the accept loop's callbacks can name it

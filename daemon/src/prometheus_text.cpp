@@ -11,10 +11,17 @@ std::string escape_label_value(std::string_view value) {
   out.reserve(value.size());
   for (char c : value) {
     switch (c) {
-      case '\\': out += "\\\\"; break;
-      case '"': out += "\\\""; break;
-      case '\n': out += "\\n"; break;
-      default: out += c;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -79,9 +86,7 @@ class Exposition {
   const char* name_ = "";
 };
 
-std::string stream_label(const StreamMetrics& s) {
-  return "stream=\"" + escape_label_value(s.stream) + "\"";
-}
+std::string stream_label(const StreamMetrics& s) { return "stream=\"" + escape_label_value(s.stream) + "\""; }
 
 }  // namespace
 

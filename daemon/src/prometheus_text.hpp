@@ -13,32 +13,31 @@ namespace neuflow::daemon {
 
 // One sink of a stream. Counters count since the daemon started, like the stream's.
 struct SinkMetrics {
-  std::string sink;            // SinkConfig::name
-  std::string kind;            // pipeline::sink_kind(): "files", "shm", "video-file", "rtsp", "udp", "display"
-  bool counts_flows = false;   // files and shm sinks count what they write
+  std::string sink;           // SinkConfig::name
+  std::string kind;           // pipeline::sink_kind(): "files", "shm", "video-file", "rtsp", "udp", "display"
+  bool counts_flows = false;  // files and shm sinks count what they write
   std::uint64_t flows_written = 0;
   std::uint64_t bytes_written = 0;  // the flow files' sizes, or the vectors published
-  std::uint64_t failures = 0;  // times it failed (or could not be built) and was cut off
+  std::uint64_t failures = 0;       // times it failed (or could not be built) and was cut off
 };
 
 // One stream as the daemon last saw it. The counters should count since the daemon started,
 // summed over the stream's restarts: Prometheus reads any decrease as a counter reset.
 struct StreamMetrics {
-  std::string stream;          // StreamConfig::name; unique within a snapshot
-  std::string state;           // "playing", "starting", "backoff", "stopped", "finished"
+  std::string stream;  // StreamConfig::name; unique within a snapshot
+  std::string state;   // "playing", "starting", "backoff", "stopped", "finished"
   std::uint64_t frames_in = 0;
   std::uint64_t frames_processed = 0;  // frames that left the flow element, with or without flow
   std::uint64_t frames_dropped = 0;
-  std::uint64_t flows = 0;           // flow fields delivered to the sinks
+  std::uint64_t flows = 0;  // flow fields delivered to the sinks
   std::uint64_t restarts = 0;
-  LatencyCounts inference;           // inference time of each flow
-  double uptime_s = 0.0;             // since the stream last reached "playing"; 0 when not playing
-  std::vector<SinkMetrics> sinks;    // in config order
+  LatencyCounts inference;         // inference time of each flow
+  double uptime_s = 0.0;           // since the stream last reached "playing"; 0 when not playing
+  std::vector<SinkMetrics> sinks;  // in config order
 };
 
 // The states render_prometheus reports as neuflow_stream_state series, one each per stream.
-inline constexpr const char* kStreamStates[] = {"playing", "starting", "backoff", "stopped",
-                                                "finished"};
+inline constexpr const char* kStreamStates[] = {"playing", "starting", "backoff", "stopped", "finished"};
 
 // The whole exposition: one family per metric, each with its # HELP and # TYPE once, samples
 // ordered as the snapshot. Families of per-stream metrics are left out when there are no

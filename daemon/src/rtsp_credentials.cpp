@@ -45,9 +45,11 @@ std::vector<RtspUser> read_rtsp_credentials(const std::filesystem::path& file) {
     if (!names.insert(user.name).second) fail("user '" + user.name + "' is listed twice");
     users.push_back(std::move(user));
   }
-  if (in.bad()) throw RtspCredentialsError("rtsp credentials " + file.string() + ": read error: " + std::strerror(errno));
+  if (in.bad())
+    throw RtspCredentialsError("rtsp credentials " + file.string() + ": read error: " + std::strerror(errno));
   if (users.empty()) {
-    throw RtspCredentialsError("rtsp credentials " + file.string() + ": no user in the file; expected user:password lines");
+    throw RtspCredentialsError("rtsp credentials " + file.string() +
+                               ": no user in the file; expected user:password lines");
   }
   return users;
 }

@@ -5,8 +5,8 @@
 #include <stdexcept>
 
 #include "log.hpp"
-#include "rtsp_credentials.hpp"
 #include "neuflow/pipeline/graph_plan.hpp"
+#include "rtsp_credentials.hpp"
 
 namespace neuflow::daemon {
 
@@ -30,8 +30,7 @@ GstRTSPAuth* RtspServer::make_auth() const {
   const bool digest = settings_.auth == "digest";
   gst_rtsp_auth_set_supported_methods(auth, digest ? GST_RTSP_AUTH_DIGEST : GST_RTSP_AUTH_BASIC);
   for (const RtspUser& user : users) {
-    GstRTSPToken* token =
-        gst_rtsp_token_new(GST_RTSP_TOKEN_MEDIA_FACTORY_ROLE, G_TYPE_STRING, kViewerRole, nullptr);
+    GstRTSPToken* token = gst_rtsp_token_new(GST_RTSP_TOKEN_MEDIA_FACTORY_ROLE, G_TYPE_STRING, kViewerRole, nullptr);
     if (digest) {
       gst_rtsp_auth_add_digest(auth, user.name.c_str(), user.password.c_str(), token);
     } else {
@@ -113,8 +112,8 @@ void RtspServer::set_mounts(const std::map<std::string, RtspMount>& mounts) {
     if (!settings_.credentials.empty()) {
       // Without a permission for it, a role is refused: only the listed users may watch.
       GstRTSPPermissions* permissions = gst_rtsp_permissions_new();
-      gst_rtsp_permissions_add_role(permissions, kViewerRole, GST_RTSP_PERM_MEDIA_FACTORY_ACCESS, G_TYPE_BOOLEAN,
-                                    TRUE, GST_RTSP_PERM_MEDIA_FACTORY_CONSTRUCT, G_TYPE_BOOLEAN, TRUE, nullptr);
+      gst_rtsp_permissions_add_role(permissions, kViewerRole, GST_RTSP_PERM_MEDIA_FACTORY_ACCESS, G_TYPE_BOOLEAN, TRUE,
+                                    GST_RTSP_PERM_MEDIA_FACTORY_CONSTRUCT, G_TYPE_BOOLEAN, TRUE, nullptr);
       gst_rtsp_media_factory_set_permissions(factory, permissions);
       gst_rtsp_permissions_unref(permissions);
     }

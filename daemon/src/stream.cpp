@@ -65,13 +65,20 @@ guint64 uint64_property(GstElement* e, const char* name) {
 
 const char* to_string(StreamState state) {
   switch (state) {
-    case StreamState::idle: return "idle";
-    case StreamState::starting: return "starting";
-    case StreamState::playing: return "playing";
-    case StreamState::backoff: return "backoff";
-    case StreamState::stopping: return "stopping";
-    case StreamState::stopped: return "stopped";
-    case StreamState::finished: return "finished";
+    case StreamState::idle:
+      return "idle";
+    case StreamState::starting:
+      return "starting";
+    case StreamState::playing:
+      return "playing";
+    case StreamState::backoff:
+      return "backoff";
+    case StreamState::stopping:
+      return "stopping";
+    case StreamState::stopped:
+      return "stopped";
+    case StreamState::finished:
+      return "finished";
   }
   return "?";
 }
@@ -395,7 +402,8 @@ void Stream::tick() {
   if (state_ == StreamState::starting && current_.processed > 0) mark_playing();
   if (state_ == StreamState::playing && seconds_since(last_progress_) > settings_.stall_timeout) {
     fail("no frames for " + std::to_string(static_cast<int>(settings_.stall_timeout)) + " s");
-  } else if (state_ == StreamState::starting && seconds_since(state_since_) > std::max(kStartTimeoutS, settings_.stall_timeout)) {
+  } else if (state_ == StreamState::starting &&
+             seconds_since(state_since_) > std::max(kStartTimeoutS, settings_.stall_timeout)) {
     fail("did not start within " + std::to_string(static_cast<int>(std::max(kStartTimeoutS, settings_.stall_timeout))) +
          " s");
   }
@@ -425,7 +433,8 @@ StreamSnapshot Stream::snapshot() const {
     StreamSnapshot::Sink out;
     out.name = sink.name;
     out.kind = std::string(pipeline::sink_kind(sink.settings));
-    out.counts_flows = std::holds_alternative<FilesSink>(sink.settings) || std::holds_alternative<ShmSink>(sink.settings);
+    out.counts_flows =
+        std::holds_alternative<FilesSink>(sink.settings) || std::holds_alternative<ShmSink>(sink.settings);
     const auto base = sink_base_.find(sink.name);
     if (base != sink_base_.end()) {
       out.flows_written = base->second.flows_written;

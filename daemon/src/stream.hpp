@@ -30,23 +30,23 @@ const char* to_string(StreamState state);
 struct StreamSnapshot {
   std::string name;
   StreamState state = StreamState::idle;
-  std::uint64_t frames_in = 0;         // over all runs of the pipeline
+  std::uint64_t frames_in = 0;  // over all runs of the pipeline
   std::uint64_t frames_processed = 0;
   std::uint64_t frames_dropped = 0;
-  std::uint64_t flows = 0;             // frames that left with a flow
+  std::uint64_t flows = 0;  // frames that left with a flow
   std::uint64_t restarts = 0;
-  LatencyCounts inference;             // every flow's inference time, over all runs
+  LatencyCounts inference;  // every flow's inference time, over all runs
   double seconds_in_state = 0;
-  double retry_in_s = 0;               // backoff only
+  double retry_in_s = 0;  // backoff only
   struct Sink {
     std::string name;
-    std::string kind;                  // pipeline::sink_kind()
-    bool counts_flows = false;         // files and shm sinks count what they write
-    std::uint64_t flows_written = 0;   // over all runs
+    std::string kind;                 // pipeline::sink_kind()
+    bool counts_flows = false;        // files and shm sinks count what they write
+    std::uint64_t flows_written = 0;  // over all runs
     std::uint64_t bytes_written = 0;
     std::uint64_t failures = 0;
   };
-  std::vector<Sink> sinks;             // in config order
+  std::vector<Sink> sinks;  // in config order
 };
 
 // One sink's counts since the daemon started.
@@ -142,7 +142,7 @@ class Stream {
   std::uint64_t last_processed_ = 0;  // for stall detection
   std::uint64_t rate_base_ = 0;       // processed count at the last rate measurement
   Clock::time_point last_rate_at_{};
-  bool rate_known_ = false;           // a rate has been measured in this run
+  bool rate_known_ = false;  // a rate has been measured in this run
   // Per sink: what finished runs wrote (and failures), and what the running pipeline wrote.
   std::map<std::string, SinkTotals> sink_base_;
   std::map<std::string, SinkTotals> sink_written_now_;  // failures unused

@@ -57,9 +57,8 @@ void BinaryInput::read(std::span<std::byte> out, const char* what) {
       throw FlowFileError(Kind::not_found, path_, std::string("read error in ") + what);
     }
     throw FlowFileError(Kind::malformed, path_,
-                        "truncated: the " + std::string(what) + " needs " +
-                            std::to_string(out.size()) + " bytes at offset " +
-                            std::to_string(position_) + " but the file is only " +
+                        "truncated: the " + std::string(what) + " needs " + std::to_string(out.size()) +
+                            " bytes at offset " + std::to_string(position_) + " but the file is only " +
                             std::to_string(size_) + " bytes");
   }
   position_ += got;
@@ -69,8 +68,8 @@ std::vector<std::byte> read_whole_file(const std::filesystem::path& path, std::u
   BinaryInput in(path);
   if (in.size() > max_bytes) {
     throw FlowFileError(Kind::malformed, path,
-                        "file is " + std::to_string(in.size()) + " bytes, more than the " +
-                            std::to_string(max_bytes) + " bytes accepted");
+                        "file is " + std::to_string(in.size()) + " bytes, more than the " + std::to_string(max_bytes) +
+                            " bytes accepted");
   }
   std::vector<std::byte> bytes(static_cast<std::size_t>(in.size()));
   in.read(bytes, "file contents");
@@ -89,9 +88,8 @@ void write_file_atomically(const std::filesystem::path& path, std::span<const st
     if (fd < 0 && errno != EEXIST) {
       throw FlowFileError(Kind::write_failed, path,
                           "cannot create a file in " +
-                              (path.parent_path().empty() ? std::string(".")
-                                                          : path.parent_path().string()) +
-                              ": " + errno_text(errno));
+                              (path.parent_path().empty() ? std::string(".") : path.parent_path().string()) + ": " +
+                              errno_text(errno));
     }
   }
   if (fd < 0) throw FlowFileError(Kind::write_failed, path, "cannot create a temporary file");

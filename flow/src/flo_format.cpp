@@ -44,8 +44,7 @@ FlowField read_flo(const std::filesystem::path& path) {
   std::array<std::byte, kHeaderBytes> header{};
   if (in.size() < kHeaderBytes) {
     throw FlowFileError(Kind::malformed, path,
-                        "truncated: " + std::to_string(in.size()) +
-                            " bytes, shorter than the 12-byte .flo header");
+                        "truncated: " + std::to_string(in.size()) + " bytes, shorter than the 12-byte .flo header");
   }
   in.read(header, "header");
   if (std::memcmp(header.data(), "PIEH", 4) != 0) {
@@ -58,17 +57,17 @@ FlowField read_flo(const std::filesystem::path& path) {
   if (!flow_size_acceptable(width, height)) {
     throw FlowFileError(Kind::malformed, path,
                         "implausible size " + std::to_string(width) + "x" + std::to_string(height) +
-                            " in the header (accepted: 1.." + std::to_string(kMaxFlowSide) +
-                            " per side, at most " + std::to_string(kMaxFlowPixels) + " pixels)");
+                            " in the header (accepted: 1.." + std::to_string(kMaxFlowSide) + " per side, at most " +
+                            std::to_string(kMaxFlowPixels) + " pixels)");
   }
   // Check against the file size before allocating what the header claims.
   const std::uint64_t expected = kHeaderBytes + 8 * static_cast<std::uint64_t>(width * height);
   if (in.size() != expected) {
     throw FlowFileError(Kind::malformed, path,
-                        std::string(in.size() < expected ? "truncated" : "trailing data") +
-                            ": the header says " + std::to_string(width) + "x" +
-                            std::to_string(height) + ", which needs " + std::to_string(expected) +
-                            " bytes, but the file is " + std::to_string(in.size()) + " bytes");
+                        std::string(in.size() < expected ? "truncated" : "trailing data") + ": the header says " +
+                            std::to_string(width) + "x" + std::to_string(height) + ", which needs " +
+                            std::to_string(expected) + " bytes, but the file is " + std::to_string(in.size()) +
+                            " bytes");
   }
 
   FlowField field(static_cast<int>(width), static_cast<int>(height));
@@ -91,8 +90,7 @@ void write_flo(const FlowField& field, const std::filesystem::path& path) {
   for (std::size_t i = 0; i < n; ++i, out += 8) {
     float u = field.uv[2 * i];
     float v = field.uv[2 * i + 1];
-    const bool valid = (field.valid.empty() || field.valid[i] != 0) && std::isfinite(u) &&
-                       std::isfinite(v);
+    const bool valid = (field.valid.empty() || field.valid[i] != 0) && std::isfinite(u) && std::isfinite(v);
     if (!valid) u = v = kFloUnknownValue;
     detail::store_le_f32(out, u);
     detail::store_le_f32(out + 4, v);

@@ -32,8 +32,7 @@ FlowField read_kitti_png(const std::filesystem::path& path) {
   if (header.bit_depth != 16) {
     throw FlowFileError(Kind::malformed, path,
                         "a KITTI flow PNG must have 16 bits per channel, this one has " +
-                            std::to_string(header.bit_depth) +
-                            " (an 8-bit PNG is an image, not a flow field)");
+                            std::to_string(header.bit_depth) + " (an 8-bit PNG is an image, not a flow field)");
   }
   if (header.color_type != 2) {
     throw FlowFileError(Kind::malformed, path,
@@ -56,8 +55,7 @@ FlowField read_kitti_png(const std::filesystem::path& path) {
       if (p[0] == 0) continue;  // invalid: keep the zero placeholder
       field.u(x, y) = (static_cast<float>(p[2]) - kZero) / kKittiScale;
       field.v(x, y) = (static_cast<float>(p[1]) - kZero) / kKittiScale;
-      field.valid[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.cols) +
-                  static_cast<std::size_t>(x)] = 1;
+      field.valid[static_cast<std::size_t>(y) * static_cast<std::size_t>(image.cols) + static_cast<std::size_t>(x)] = 1;
     }
   }
   return field;

@@ -38,16 +38,13 @@ FlowMetrics metrics_from_counts(const MetricCounts& counts, std::size_t total_pi
   return m;
 }
 
-FlowMetrics compute_metrics(const FlowField& predicted, const FlowField& ground_truth,
-                            const MetricsOptions& options) {
+FlowMetrics compute_metrics(const FlowField& predicted, const FlowField& ground_truth, const MetricsOptions& options) {
   detail::check_field(predicted, "compute_metrics (prediction)");
   detail::check_field(ground_truth, "compute_metrics (ground truth)");
   if (predicted.width != ground_truth.width || predicted.height != ground_truth.height) {
-    throw std::invalid_argument("compute_metrics: prediction is " +
-                                std::to_string(predicted.width) + "x" +
+    throw std::invalid_argument("compute_metrics: prediction is " + std::to_string(predicted.width) + "x" +
                                 std::to_string(predicted.height) + " but ground truth is " +
-                                std::to_string(ground_truth.width) + "x" +
-                                std::to_string(ground_truth.height));
+                                std::to_string(ground_truth.width) + "x" + std::to_string(ground_truth.height));
   }
 
   constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -25,7 +25,7 @@ namespace {
 using Kind = FlowFileError::Kind;
 
 constexpr char kMagic[6] = {'\x93', 'N', 'U', 'M', 'P', 'Y'};
-constexpr std::size_t kAlign = 64;             // numpy pads the header to this since 1.14
+constexpr std::size_t kAlign = 64;                  // numpy pads the header to this since 1.14
 constexpr std::uint32_t kMaxHeaderBytes = 1 << 20;  // numpy itself refuses > 10000 by default
 
 using Shape = std::vector<std::int64_t>;
@@ -67,13 +67,12 @@ class HeaderParser {
  private:
   [[noreturn]] void fail(const std::string& what) const {
     throw FlowFileError(Kind::malformed, path_,
-                        "cannot parse the .npy header at character " + std::to_string(pos_) +
-                            ": " + what + " (header: " + std::string(s_) + ")");
+                        "cannot parse the .npy header at character " + std::to_string(pos_) + ": " + what +
+                            " (header: " + std::string(s_) + ")");
   }
   char peek() const { return pos_ < s_.size() ? s_[pos_] : '\0'; }
   void skip_space() {
-    while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\t' || s_[pos_] == '\n' ||
-                                s_[pos_] == '\r')) {
+    while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\t' || s_[pos_] == '\n' || s_[pos_] == '\r')) {
       ++pos_;
     }
   }
@@ -148,25 +147,29 @@ std::string shape_text(const Shape& shape) {
 }
 
 std::string describe_dtype(const std::string& descr) {
-  static const std::map<std::string, std::string, std::less<>> names = {
-      {"<f8", "float64"}, {">f8", "big-endian float64"}, {">f4", "big-endian float32"},
-      {"<f2", "float16"}, {"<i4", "int32"},               {"<i8", "int64"},
-      {"|u1", "uint8"},   {"<u2", "uint16"},              {"|b1", "bool"}};
+  static const std::map<std::string, std::string, std::less<>> names = {{"<f8", "float64"},
+                                                                        {">f8", "big-endian float64"},
+                                                                        {">f4", "big-endian float32"},
+                                                                        {"<f2", "float16"},
+                                                                        {"<i4", "int32"},
+                                                                        {"<i8", "int64"},
+                                                                        {"|u1", "uint8"},
+                                                                        {"<u2", "uint16"},
+                                                                        {"|b1", "bool"}};
   const auto it = names.find(descr);
   return "'" + descr + "'" + (it != names.end() ? " (" + it->second + ")" : std::string());
 }
 
 template <class T>
-const T& require_key(const std::map<std::string, HeaderValue>& dict, const char* key,
-                     const char* type_name, const std::filesystem::path& path) {
+const T& require_key(const std::map<std::string, HeaderValue>& dict, const char* key, const char* type_name,
+                     const std::filesystem::path& path) {
   const auto it = dict.find(key);
   if (it == dict.end()) {
     throw FlowFileError(Kind::malformed, path, std::string(".npy header has no '") + key + "'");
   }
   const T* value = std::get_if<T>(&it->second);
   if (value == nullptr) {
-    throw FlowFileError(Kind::malformed, path,
-                        std::string(".npy header entry '") + key + "' is not " + type_name);
+    throw FlowFileError(Kind::malformed, path, std::string(".npy header entry '") + key + "' is not " + type_name);
   }
   return *value;
 }
@@ -191,8 +194,7 @@ NpyArray read_npy_array(const std::filesystem::path& path, const NpyShapeCheck& 
   std::array<std::byte, 12> prefix{};
   if (in.size() < 10) {
     throw FlowFileError(Kind::malformed, path,
-                        "truncated: " + std::to_string(in.size()) +
-                            " bytes, too short for an .npy header");
+                        "truncated: " + std::to_string(in.size()) + " bytes, too short for an .npy header");
   }
   in.read(std::span(prefix).first(10), "header prefix");
   if (std::memcmp(prefix.data(), kMagic, sizeof kMagic) != 0) {
@@ -202,8 +204,8 @@ NpyArray read_npy_array(const std::filesystem::path& path, const NpyShapeCheck& 
   const int minor = std::to_integer<int>(prefix[7]);
   if (minor != 0 || major < 1 || major > 3) {
     throw FlowFileError(Kind::malformed, path,
-                        "unsupported .npy format version " + std::to_string(major) + "." +
-                            std::to_string(minor) + " (supported: 1.0, 2.0, 3.0)");
+                        "unsupported .npy format version " + std::to_string(major) + "." + std::to_string(minor) +
+                            " (supported: 1.0, 2.0, 3.0)");
   }
   std::uint64_t prefix_len = 10;
   std::uint32_t header_len = detail::load_le_u16(prefix.data() + 8);
@@ -214,16 +216,15 @@ NpyArray read_npy_array(const std::filesystem::path& path, const NpyShapeCheck& 
   }
   if (header_len > kMaxHeaderBytes || prefix_len + header_len > in.size()) {
     throw FlowFileError(Kind::malformed, path,
-                        "implausible .npy header length " + std::to_string(header_len) +
-                            " for a file of " + std::to_string(in.size()) + " bytes");
+                        "implausible .npy header length " + std::to_string(header_len) + " for a file of " +
+                            std::to_string(in.size()) + " bytes");
   }
   std::string header(header_len, '\0');
   in.read(std::as_writable_bytes(std::span(header)), "header");
 
   const auto dict = HeaderParser(header, path).parse();
   if (dict.size() != 3) {
-    throw FlowFileError(Kind::malformed, path,
-                        ".npy header must have exactly the keys descr, fortran_order and shape");
+    throw FlowFileError(Kind::malformed, path, ".npy header must have exactly the keys descr, fortran_order and shape");
   }
   const auto& descr = require_key<std::string>(dict, "descr", "a string", path);
   const bool fortran = require_key<bool>(dict, "fortran_order", "True/False", path);
@@ -252,8 +253,8 @@ NpyArray read_npy_array(const std::filesystem::path& path, const NpyShapeCheck& 
   if (too_large || 4 * count != data_bytes) {
     const bool truncated = too_large || 4 * count > data_bytes;
     throw FlowFileError(Kind::malformed, path,
-                        std::string(truncated ? "truncated" : "trailing data") + ": shape " +
-                            shape_text(shape) + " needs " +
+                        std::string(truncated ? "truncated" : "trailing data") + ": shape " + shape_text(shape) +
+                            " needs " +
                             (too_large ? std::string("more bytes than the file has")
                                        : std::to_string(prefix_len + header_len + 4 * count) + " bytes") +
                             ", but the file is " + std::to_string(in.size()) + " bytes");
@@ -270,15 +271,14 @@ NpyArray read_npy_array(const std::filesystem::path& path, const NpyShapeCheck& 
 FlowField read_npy(const std::filesystem::path& path) {
   NpyArray array = read_npy_array(path, [&](const Shape& shape) {
     if (shape.size() != 3 || shape[2] != 2) {
-      throw FlowFileError(Kind::malformed, path,
-                          "array shape " + shape_text(shape) +
-                              " is not a flow field; expected (H, W, 2) with u, v last");
+      throw FlowFileError(
+          Kind::malformed, path,
+          "array shape " + shape_text(shape) + " is not a flow field; expected (H, W, 2) with u, v last");
     }
     if (!flow_size_acceptable(shape[1], shape[0])) {
       throw FlowFileError(Kind::malformed, path,
-                          "implausible flow size " + std::to_string(shape[1]) + "x" +
-                              std::to_string(shape[0]) + " (accepted: 1.." +
-                              std::to_string(kMaxFlowSide) + " per side, at most " +
+                          "implausible flow size " + std::to_string(shape[1]) + "x" + std::to_string(shape[0]) +
+                              " (accepted: 1.." + std::to_string(kMaxFlowSide) + " per side, at most " +
                               std::to_string(kMaxFlowPixels) + " pixels)");
     }
   });
@@ -292,9 +292,8 @@ FlowField read_npy(const std::filesystem::path& path) {
 
 void write_npy(const FlowField& field, const std::filesystem::path& path) {
   detail::check_field(field, "write_npy " + path.string());
-  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
-                       std::to_string(field.height) + ", " + std::to_string(field.width) +
-                       ", 2), }";
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + std::to_string(field.height) + ", " +
+                       std::to_string(field.width) + ", 2), }";
   // Same rule as numpy's _wrap_header: 1..64 spaces, then '\n', so the data starts aligned.
   const std::size_t unpadded = sizeof kMagic + 2 + 2 + header.size() + 1;
   header.append(kAlign - unpadded % kAlign, ' ');

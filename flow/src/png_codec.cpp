@@ -30,12 +30,18 @@ std::uint32_t load_be_u32(const std::byte* p) {
 
 const char* png_color_type_name(int color_type) {
   switch (color_type) {
-    case 0: return "grayscale";
-    case 2: return "RGB";
-    case 3: return "palette";
-    case 4: return "grayscale+alpha";
-    case 6: return "RGBA";
-    default: return "unknown colour type";
+    case 0:
+      return "grayscale";
+    case 2:
+      return "RGB";
+    case 3:
+      return "palette";
+    case 4:
+      return "grayscale+alpha";
+    case 6:
+      return "RGBA";
+    default:
+      return "unknown colour type";
   }
 }
 
@@ -56,9 +62,8 @@ PngHeader parse_png_header(std::span<const std::byte> bytes, const std::filesyst
   h.color_type = std::to_integer<int>(bytes[25]);
   if (!flow_size_acceptable(h.width, h.height)) {
     throw FlowFileError(Kind::malformed, path,
-                        "implausible PNG size " + std::to_string(h.width) + "x" +
-                            std::to_string(h.height) + " (accepted: 1.." +
-                            std::to_string(kMaxFlowSide) + " per side, at most " +
+                        "implausible PNG size " + std::to_string(h.width) + "x" + std::to_string(h.height) +
+                            " (accepted: 1.." + std::to_string(kMaxFlowSide) + " per side, at most " +
                             std::to_string(kMaxFlowPixels) + " pixels)");
   }
   return h;
@@ -174,10 +179,9 @@ void write_png_atomically(const cv::Mat& image, const std::filesystem::path& pat
     png_set_write_fn(png, &encoded, write_to_memory, flush_nothing);
     // zlib level 1, as OpenCV's imwrite: flows are written as fast as they arrive.
     png_set_compression_level(png, 1);
-    const int color =
-        channels == 1 ? PNG_COLOR_TYPE_GRAY : channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA;
-    png_set_IHDR(png, info, static_cast<png_uint_32>(image.cols), static_cast<png_uint_32>(image.rows), depth,
-                 color, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    const int color = channels == 1 ? PNG_COLOR_TYPE_GRAY : channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA;
+    png_set_IHDR(png, info, static_cast<png_uint_32>(image.cols), static_cast<png_uint_32>(image.rows), depth, color,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
     if (channels > 1) png_set_bgr(png);
     if (depth == 16 && kSwap16) png_set_swap(png);

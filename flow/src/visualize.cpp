@@ -65,14 +65,14 @@ Visualization visualize_flow(const FlowField& field, const VisualizeOptions& opt
 void write_rgb_png(const RgbImage& image, const std::filesystem::path& path) {
   if (!flow_size_acceptable(image.width, image.height) ||
       image.rgb.size() != 3 * static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height)) {
-    throw std::invalid_argument("write_rgb_png " + path.string() + ": image of " +
-                                std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                " has " + std::to_string(image.rgb.size()) + " bytes");
+    throw std::invalid_argument("write_rgb_png " + path.string() + ": image of " + std::to_string(image.width) + "x" +
+                                std::to_string(image.height) + " has " + std::to_string(image.rgb.size()) + " bytes");
   }
   cv::Mat bgr(image.height, image.width, CV_8UC3);
   for (int y = 0; y < image.height; ++y) {
     auto* row = bgr.ptr<cv::Vec3b>(y);
-    const std::uint8_t* src = image.rgb.data() + 3 * static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width);
+    const std::uint8_t* src =
+        image.rgb.data() + 3 * static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width);
     for (int x = 0; x < image.width; ++x, src += 3) row[x] = cv::Vec3b(src[2], src[1], src[0]);
   }
   detail::write_png_atomically(bgr, path);

@@ -25,8 +25,8 @@ class LayerTable {
     layers_.push_back({std::move(name), LayerKind::batch_norm, channels, channels, 0, true, stage, 8, 0});
   }
   void layer_norm(std::string name, int channels) {
-    layers_.push_back({std::move(name), LayerKind::layer_norm, channels, channels, 0, true, Stage::cross_attention,
-                       16, 0});
+    layers_.push_back(
+        {std::move(name), LayerKind::layer_norm, channels, channels, 0, true, Stage::cross_attention, 16, 0});
   }
   // ConvBlock(in -> out, k): conv1 (k x k, no bias), conv2 (3x3, no bias), norm1, norm2.
   void conv_block(const std::string& prefix, int in, int out, int k, Stage stage, int scale) {
@@ -156,8 +156,7 @@ ParameterKind classify_key(std::string_view key) {
 ParameterCount count_parameters(const Checkpoint& checkpoint) {
   ParameterCount count;
   for (const auto& [key, tensor] : checkpoint.tensors) {
-    (classify_key(key) == ParameterKind::kParameter ? count.parameters : count.buffers) +=
-        tensor.numel();
+    (classify_key(key) == ParameterKind::kParameter ? count.parameters : count.buffers) += tensor.numel();
   }
   return count;
 }
@@ -175,9 +174,8 @@ std::optional<std::string> find_architecture_mismatch(const Checkpoint& checkpoi
     }
   }
   if (first_missing != nullptr) {
-    return "missing tensor '" + first_missing->name + "' " + shape_text(first_missing->shape) +
-           " (" + std::to_string(missing) + " of NeuFlow-V2's " + std::to_string(total) +
-           " tensors are absent)";
+    return "missing tensor '" + first_missing->name + "' " + shape_text(first_missing->shape) + " (" +
+           std::to_string(missing) + " of NeuFlow-V2's " + std::to_string(total) + " tensors are absent)";
   }
 
   std::unordered_set<std::string_view> known;
@@ -191,16 +189,15 @@ std::optional<std::string> find_architecture_mismatch(const Checkpoint& checkpoi
     }
   }
   if (first_unexpected != nullptr) {
-    return "unexpected tensor '" + *first_unexpected + "' " +
-           shape_text(checkpoint.at(*first_unexpected).shape) + ", not part of NeuFlow-V2 (" +
-           std::to_string(unexpected) + " unexpected tensors)";
+    return "unexpected tensor '" + *first_unexpected + "' " + shape_text(checkpoint.at(*first_unexpected).shape) +
+           ", not part of NeuFlow-V2 (" + std::to_string(unexpected) + " unexpected tensors)";
   }
 
   for (const auto& spec : table) {
     const CheckpointTensor* tensor = checkpoint.find(spec.name);
     if (tensor != nullptr && tensor->shape != spec.shape) {
-      return "tensor '" + spec.name + "' has shape " + shape_text(tensor->shape) +
-             " but NeuFlow-V2 expects " + shape_text(spec.shape);
+      return "tensor '" + spec.name + "' has shape " + shape_text(tensor->shape) + " but NeuFlow-V2 expects " +
+             shape_text(spec.shape);
     }
   }
   return std::nullopt;

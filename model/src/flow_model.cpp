@@ -18,7 +18,8 @@ std::shared_ptr<const FlowModel> FlowModel::load(const std::filesystem::path& ch
   auto weights = [&] {
     const Checkpoint checkpoint = load_checkpoint(checkpoint_path);
     if (auto mismatch = find_architecture_mismatch(checkpoint)) {
-      throw CheckpointError(CheckpointError::Kind::kFormat, checkpoint_path.string() + ": not a NeuFlow-V2 checkpoint: " + *mismatch);
+      throw CheckpointError(CheckpointError::Kind::kFormat,
+                            checkpoint_path.string() + ": not a NeuFlow-V2 checkpoint: " + *mismatch);
     }
     return std::make_unique<const NetworkWeights>(build_network_weights(checkpoint));
   }();  // the checkpoint's own copy of the weights is released here

@@ -203,9 +203,8 @@ namespace {
 int next_stream_slot(const FlowSession::State& s) { return s.previous_slot == 0 ? 1 : 0; }
 
 // One frame of a stream, computed now: push()'s work, without its check for frames in flight.
-std::optional<flow::FlowField> stream_now(FlowSession::State& s, const FlowModel& model,
-                                          const SessionOptions& options, const ImageView& frame,
-                                          const Iterations& iterations) {
+std::optional<flow::FlowField> stream_now(FlowSession::State& s, const FlowModel& model, const SessionOptions& options,
+                                          const ImageView& frame, const Iterations& iterations) {
   validate(iterations);
   apply_threads(options.threads);
   const FrameGeometry& g = prepare_plan(s, model, options, frame.width, frame.height);

@@ -14,17 +14,17 @@ inline constexpr int kBackbone16Channels = kFeatureChannels - 2;
 
 // The refinement: a 9×9 correlation window (radius 4), a hidden state, the flow.
 inline constexpr int kCorrRadius = 4;
-inline constexpr int kCorrWindow = 2 * kCorrRadius + 1;     // 9
+inline constexpr int kCorrWindow = 2 * kCorrRadius + 1;          // 9
 inline constexpr int kCorrChannels = kCorrWindow * kCorrWindow;  // 81
 inline constexpr int kHiddenChannels = 64;
 // Its input, in the order the dynamic part of conv1 reads it: corr, hidden, flow; then the part
 // fixed for a pair: context, the radius plane.
 inline constexpr int kRefineDynamicChannels = kCorrChannels + kHiddenChannels + 2;  // 147
-inline constexpr int kRefineHiddenOffset = kCorrChannels;                      // in the dynamic part
+inline constexpr int kRefineHiddenOffset = kCorrChannels;                           // in the dynamic part
 inline constexpr int kRefineFlowOffset = kCorrChannels + kHiddenChannels;
-inline constexpr int kRefineConstantChannels = kContextChannels + 1;                  // 65
+inline constexpr int kRefineConstantChannels = kContextChannels + 1;                           // 65
 inline constexpr int kRefineInputChannels = kRefineDynamicChannels + kRefineConstantChannels;  // 212
-inline constexpr int kRefineHiddenWidth = 128;  // conv1's output
+inline constexpr int kRefineHiddenWidth = 128;                                                 // conv1's output
 inline constexpr int kRefineOutputChannels = 2 + kHiddenChannels;  // conv3: flow update, hidden
 inline constexpr float kCorrRadiusPlane = static_cast<float>(kCorrRadius);
 

@@ -37,8 +37,7 @@ std::optional<std::string> check_device(int value) {
 
 std::optional<std::string> check_model_side(int value) {
   using L = SessionLimits;
-  if (value == 0 ||
-      (value >= L::min_side && value <= L::max_side && value % L::model_side_multiple == 0)) {
+  if (value == 0 || (value >= L::min_side && value <= L::max_side && value % L::model_side_multiple == 0)) {
     return std::nullopt;
   }
   return "expected a multiple of " + std::to_string(L::model_side_multiple) + ", at least " +
@@ -102,7 +101,8 @@ std::optional<CpuConvolution> cpu_convolution_from_environment() {
   const char* value = std::getenv("NEUFLOW_CONV");
   if (!value || !*value) return std::nullopt;
   if (const auto parsed = parse_cpu_convolution(value)) return parsed;
-  throw std::invalid_argument(std::string("NEUFLOW_CONV: expected auto, direct, winograd, winograd4 or winograd6, got \"") + value + "\"");
+  throw std::invalid_argument(
+      std::string("NEUFLOW_CONV: expected auto, direct, winograd, winograd4 or winograd6, got \"") + value + "\"");
 }
 
 }  // namespace neuflow::model

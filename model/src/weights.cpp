@@ -23,7 +23,8 @@ class WeightReader {
     }
     if (it->second.shape != shape) {
       throw CheckpointError(CheckpointError::Kind::kFormat, ckpt_.path + ": tensor '" + name + "' has shape " +
-                            shape_text(it->second.shape) + ", expected " + shape_text(shape));
+                                                                shape_text(it->second.shape) + ", expected " +
+                                                                shape_text(shape));
     }
     return it->second.data;
   }

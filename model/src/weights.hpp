@@ -6,8 +6,8 @@
 #include <array>
 #include <vector>
 
-#include "neuflow/model/checkpoint.hpp"
 #include "network_dims.hpp"
+#include "neuflow/model/checkpoint.hpp"
 
 namespace neuflow::model {
 

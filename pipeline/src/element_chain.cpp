@@ -48,7 +48,8 @@ std::vector<std::string> factories_of(const ElementChain& chain) {
 std::string launch_text(const ElementChain& chain) {
   std::string text;
   for (const auto& spec : chain) {
-    if (!spec.children.empty()) throw std::logic_error(spec.factory + ": element-valued properties have no launch syntax");
+    if (!spec.children.empty())
+      throw std::logic_error(spec.factory + ": element-valued properties have no launch syntax");
     if (!text.empty()) text += " ! ";
     // A bare capsfilter reads best (and is written most often) as its caps.
     if (spec.factory == "capsfilter" && spec.name.empty() && spec.properties.size() == 1 &&

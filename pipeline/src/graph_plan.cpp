@@ -83,7 +83,8 @@ SourcePlan plan_source(const SourceDescription& source) {
     return {{element("uridecodebin", "source").set("uri", u->uri)}, true};
   }
   const auto& t = std::get<TestSource>(source);
-  ElementSpec src = element("videotestsrc", "source").set("pattern", t.pattern).set("is-live", t.live ? "true" : "false");
+  ElementSpec src =
+      element("videotestsrc", "source").set("pattern", t.pattern).set("is-live", t.live ? "true" : "false");
   if (t.frames >= 0) src.set("num-buffers", std::to_string(t.frames));
   return {{src, caps_filter(caps_text("video/x-raw", t.mode, VideoMode{320, 240, 30, 1}))}};
 }
@@ -111,9 +112,12 @@ std::string_view sink_kind(const SinkDescription& sink) {
   if (std::holds_alternative<ShmSink>(sink)) return "shm";
   if (std::holds_alternative<DisplaySink>(sink)) return "display";
   switch (std::get<VideoSink>(sink).target) {
-    case VideoSink::Target::file: return "video-file";
-    case VideoSink::Target::rtsp: return "rtsp";
-    case VideoSink::Target::udp: return "udp";
+    case VideoSink::Target::file:
+      return "video-file";
+    case VideoSink::Target::rtsp:
+      return "rtsp";
+    case VideoSink::Target::udp:
+      return "udp";
   }
   return "video";
 }
@@ -159,20 +163,23 @@ SinkPlan plan_sink(const std::string& graph, const NamedSink& sink, const PlanCo
                             .set("max-size-time", std::to_string(static_cast<guint64>(v.segment_seconds) * GST_SECOND));
       mux.children = {{"muxer", element(v.file.extension() == ".mkv" ? "matroskamux" : "mp4mux", p + "muxer")},
                       {"sink", no_preroll(element("filesink", p + "file"))}};
-      plan.chain = {element("queue", p + "queue"), visualizer(p + "viz", v.max_flow),
+      plan.chain = {element("queue", p + "queue"),          visualizer(p + "viz", v.max_flow),
                     element("videoconvert", p + "convert"), h264_encoder(p + "x264", v.bitrate_kbps, false),
-                    element("h264parse", p + "parse"), mux};
+                    element("h264parse", p + "parse"),      mux};
       if (!v.file.parent_path().empty()) plan.folders = {v.file.parent_path()};
       return plan;
     }
     case VideoSink::Target::rtsp:
-      plan.chain = {leaky_queue(p + "queue"), visualizer(p + "viz", v.max_flow), element("videoconvert", p + "convert"),
-                    no_preroll(element("intervideosink", p + "inter"))
-                        .set("channel", rtsp_channel_name(graph, v.rtsp_mount))};
+      plan.chain = {
+          leaky_queue(p + "queue"), visualizer(p + "viz", v.max_flow), element("videoconvert", p + "convert"),
+          no_preroll(element("intervideosink", p + "inter")).set("channel", rtsp_channel_name(graph, v.rtsp_mount))};
       return plan;
     case VideoSink::Target::udp:
-      plan.chain = {leaky_queue(p + "queue"), visualizer(p + "viz", v.max_flow), element("videoconvert", p + "convert"),
-                    h264_encoder(p + "x264", v.bitrate_kbps, true), rtp_h264_payloader(p + "pay"),
+      plan.chain = {leaky_queue(p + "queue"),
+                    visualizer(p + "viz", v.max_flow),
+                    element("videoconvert", p + "convert"),
+                    h264_encoder(p + "x264", v.bitrate_kbps, true),
+                    rtp_h264_payloader(p + "pay"),
                     element("udpsink", p + "udp")
                         .set("host", v.udp_host)
                         .set("port", std::to_string(v.udp_port))

@@ -35,8 +35,8 @@ GstElement* make_element(const char* factory, const std::string& subject) {
   GstElement* element = gst_element_factory_make(factory, nullptr);
   if (!element) {
     throw PipelineError(PipelineError::Kind::missing_element, subject,
-                        std::string("the GStreamer element '") + factory + "' is not installed (Debian: " +
-                            std::string(package_of(factory)) + ")");
+                        std::string("the GStreamer element '") + factory +
+                            "' is not installed (Debian: " + std::string(package_of(factory)) + ")");
   }
   return element;
 }

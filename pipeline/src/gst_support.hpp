@@ -26,8 +26,8 @@ using GstPtr = std::unique_ptr<T, ObjectUnref>;
 GstElement* make_element(const char* factory, const std::string& subject);
 
 struct BusError {
-  std::string text;           // GStreamer's message, with the reason for vague stream errors
-  bool resource = false;      // a file or network resource could not be opened or read
+  std::string text;       // GStreamer's message, with the reason for vague stream errors
+  bool resource = false;  // a file or network resource could not be opened or read
 };
 // The first error waiting on the bus, without blocking.
 std::optional<BusError> pop_bus_error(GstBus* bus);

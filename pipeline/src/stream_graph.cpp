@@ -98,9 +98,8 @@ SinkBranch* StreamGraph::branch_of(GstObject* element) {
 }
 
 size_t StreamGraph::live_branches() const {
-  return static_cast<size_t>(std::count_if(sinks_.begin(), sinks_.end(), [](const auto& b) {
-    return !b->failed.load(std::memory_order_acquire);
-  }));
+  return static_cast<size_t>(std::count_if(sinks_.begin(), sinks_.end(),
+                                           [](const auto& b) { return !b->failed.load(std::memory_order_acquire); }));
 }
 
 void StreamGraph::remove_branch(SinkBranch& branch) {

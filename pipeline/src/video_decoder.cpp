@@ -36,7 +36,8 @@ std::string to_uri(const std::string& source) {
   std::error_code ec;
   const auto status = std::filesystem::status(source, ec);
   if (!std::filesystem::exists(status)) throw PipelineError(Kind::not_found, source, "no such file");
-  if (std::filesystem::is_directory(status)) throw PipelineError(Kind::not_found, source, "is a folder, not a video file");
+  if (std::filesystem::is_directory(status))
+    throw PipelineError(Kind::not_found, source, "is a folder, not a video file");
   GError* error = nullptr;
   gchar* uri = gst_filename_to_uri(source.c_str(), &error);
   if (!uri) {
@@ -92,8 +93,8 @@ void VideoDecoder::Impl::on_pad_added(GstElement*, GstPad* pad, gpointer user_da
   if (impl->video_linked) return;
   GstCaps* caps = gst_pad_get_current_caps(pad);
   if (!caps) caps = gst_pad_query_caps(pad, nullptr);
-  const bool is_video = caps && gst_caps_get_size(caps) > 0 &&
-                        gst_structure_has_name(gst_caps_get_structure(caps, 0), "video/x-raw");
+  const bool is_video =
+      caps && gst_caps_get_size(caps) > 0 && gst_structure_has_name(gst_caps_get_structure(caps, 0), "video/x-raw");
   if (caps) gst_caps_unref(caps);
   if (!is_video) return;
   GstPad* sink_pad = gst_element_get_static_pad(impl->convert, "sink");
@@ -222,9 +223,9 @@ void VideoDecoder::Impl::learn_stream_properties(const GstVideoInfo& info) {
   }
   gint64 duration = 0;
   if (rate.known() && gst_element_query_duration(pipeline.get(), GST_FORMAT_TIME, &duration) && duration > 0) {
-    frame_count = static_cast<std::int64_t>(gst_util_uint64_scale_round(
-        static_cast<guint64>(duration), static_cast<guint64>(rate.numerator),
-        static_cast<guint64>(rate.denominator) * GST_SECOND));
+    frame_count = static_cast<std::int64_t>(
+        gst_util_uint64_scale_round(static_cast<guint64>(duration), static_cast<guint64>(rate.numerator),
+                                    static_cast<guint64>(rate.denominator) * GST_SECOND));
   }
 }
 

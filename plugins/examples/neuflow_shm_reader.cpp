@@ -8,9 +8,9 @@
 // Exit status: 0 done, 1 a checksum failed (--check), 2 usage or ring error, 3 the ring or
 // --count flows not seen before --timeout.
 #include <algorithm>
-#include <csignal>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -127,7 +127,8 @@ class Follower {
 
   int run() {
     if (o_.timeout_s) {
-      deadline_ = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*o_.timeout_s));
+      deadline_ =
+          Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(*o_.timeout_s));
     }
     std::optional<ring::FlowRingReader> reader = open();
     // Starts with the newest flow, then follows every one published after it.
@@ -157,10 +158,17 @@ class Follower {
       uv_.resize(reader->values_per_flow());
       ring::FlowInfo info;
       switch (reader->read(next, uv_, info)) {
-        case ring::ReadStatus::ok: report(*reader, info); break;
-        case ring::ReadStatus::overwritten: ++stats_.missed; break;
-        case ring::ReadStatus::torn: ++stats_.torn; break;
-        case ring::ReadStatus::not_published: continue;  // cannot happen for next <= published
+        case ring::ReadStatus::ok:
+          report(*reader, info);
+          break;
+        case ring::ReadStatus::overwritten:
+          ++stats_.missed;
+          break;
+        case ring::ReadStatus::torn:
+          ++stats_.torn;
+          break;
+        case ring::ReadStatus::not_published:
+          continue;  // cannot happen for next <= published
       }
       ++next;
     }
@@ -215,16 +223,17 @@ class Follower {
     ++stats_.read;
     // A flow that passed the seqlock but not its checksum would be a torn read: the
     // failure this reader exists to catch.
-    const bool whole = info.grid_width == reader.width() && info.grid_height == reader.height() &&
-                       ring::verify(uv_, info);
+    const bool whole =
+        info.grid_width == reader.width() && info.grid_height == reader.height() && ring::verify(uv_, info);
     if (!whole) ++stats_.bad_checksum;
     if (o_.quiet && whole) return;
-    std::printf("seq=%llu frames=%llu->%llu pts=%s->%s grid=%ux%u frame=%ux%u mean|flow|=%.4f inference=%.1fms crc=%s\n",
-                static_cast<unsigned long long>(info.sequence), static_cast<unsigned long long>(info.from_frame),
-                static_cast<unsigned long long>(info.to_frame), seconds(info.from_pts_ns).c_str(),
-                seconds(info.to_pts_ns).c_str(), info.grid_width, info.grid_height, info.frame_width,
-                info.frame_height, mean_magnitude(uv_, reader.values_per_flow()),
-                static_cast<double>(info.inference_ns) / 1e6, whole ? "ok" : "MISMATCH");
+    std::printf(
+        "seq=%llu frames=%llu->%llu pts=%s->%s grid=%ux%u frame=%ux%u mean|flow|=%.4f inference=%.1fms crc=%s\n",
+        static_cast<unsigned long long>(info.sequence), static_cast<unsigned long long>(info.from_frame),
+        static_cast<unsigned long long>(info.to_frame), seconds(info.from_pts_ns).c_str(),
+        seconds(info.to_pts_ns).c_str(), info.grid_width, info.grid_height, info.frame_width, info.frame_height,
+        mean_magnitude(uv_, reader.values_per_flow()), static_cast<double>(info.inference_ns) / 1e6,
+        whole ? "ok" : "MISMATCH");
     std::fflush(stdout);
   }
 

@@ -41,10 +41,20 @@ std::optional<NamePattern> split(const std::string& name) {
     if (k == name.size()) return std::nullopt;
     NamePattern p;
     switch (name[k]) {
-      case 'd': case 'i': case 'u': p.base = 10; break;
-      case 'x': case 'X': p.base = 16; break;
-      case 'o': p.base = 8; break;
-      default: return std::nullopt;
+      case 'd':
+      case 'i':
+      case 'u':
+        p.base = 10;
+        break;
+      case 'x':
+      case 'X':
+        p.base = 16;
+        break;
+      case 'o':
+        p.base = 8;
+        break;
+      default:
+        return std::nullopt;
     }
     p.prefix = unescape_percent(std::string_view(name).substr(0, i));
     p.suffix = unescape_percent(std::string_view(name).substr(k + 1));

@@ -10,7 +10,7 @@ namespace neuflow::gst {
 
 struct EarlierFile {
   std::string path;
-  std::int64_t index = 0;   // the number the pattern's conversion put in its name
+  std::int64_t index = 0;  // the number the pattern's conversion put in its name
   std::uint64_t bytes = 0;
 };
 

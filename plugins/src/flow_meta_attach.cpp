@@ -8,8 +8,8 @@ GstBuffer* attach_flow(GstBuffer* buffer, const flow::FlowField& flow, const Flo
                        const model::SessionOptions& options, double inference_seconds) {
   buffer = gst_buffer_make_writable(buffer);
   GBytes* bytes = g_bytes_new(flow.uv.data(), flow.uv.size() * sizeof(float));
-  NeuflowFlowMeta* meta = neuflow_buffer_add_flow_meta(buffer, static_cast<guint>(flow.width),
-                                                       static_cast<guint>(flow.height), bytes);
+  NeuflowFlowMeta* meta =
+      neuflow_buffer_add_flow_meta(buffer, static_cast<guint>(flow.width), static_cast<guint>(flow.height), bytes);
   g_bytes_unref(bytes);
   meta->from_pts = ends.from_pts;
   meta->to_pts = ends.to_pts;

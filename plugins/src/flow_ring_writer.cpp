@@ -59,8 +59,8 @@ void mark_closed(int fd) {
   if (::fstat(fd, &st) != 0 || static_cast<std::uint64_t>(st.st_size) < sizeof(ring::RingHeader)) return;
   void *p = ::mmap(nullptr, sizeof(ring::RingHeader), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   if (p == MAP_FAILED) return;
-  state_of(static_cast<std::byte *>(p)).store(static_cast<std::uint32_t>(ring::SegmentState::closed),
-                                              std::memory_order_release);
+  state_of(static_cast<std::byte *>(p))
+      .store(static_cast<std::uint32_t>(ring::SegmentState::closed), std::memory_order_release);
   ::munmap(p, sizeof(ring::RingHeader));
 }
 
@@ -275,8 +275,8 @@ void FlowRingWriter::publish(std::uint32_t width, std::uint32_t height, const Fl
   h.iters_s16 = record.iters_s16;
   h.iters_s8 = record.iters_s8;
   // Computed from the source, before the slot is opened, to keep the odd window short.
-  h.crc32 = static_cast<std::uint32_t>(
-      ::crc32_z(::crc32_z(0, nullptr, 0), reinterpret_cast<const Bytef *>(uv.data()), static_cast<z_size_t>(data_bytes_)));
+  h.crc32 = static_cast<std::uint32_t>(::crc32_z(::crc32_z(0, nullptr, 0), reinterpret_cast<const Bytef *>(uv.data()),
+                                                 static_cast<z_size_t>(data_bytes_)));
   h.data_bytes = data_bytes_;
 
   // Seqlock write: odd word, release fence, contents, even word (release). A reader whose

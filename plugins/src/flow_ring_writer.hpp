@@ -51,8 +51,7 @@ class FlowRingWriter {
   // larger; each later segment gets the next. Throws FlowRingError naming the segment and
   // the reason.
   // Every segment gets `mode` exactly (whatever the umask), see check_flow_ring_mode.
-  FlowRingWriter(std::string name, std::uint32_t slots, std::uint64_t first_generation,
-                 mode_t mode = kFlowRingMode);
+  FlowRingWriter(std::string name, std::uint32_t slots, std::uint64_t first_generation, mode_t mode = kFlowRingMode);
   // Marks the segment closed and unlinks the name (if it still names this segment); readers
   // that have it mapped keep reading the flows it holds.
   ~FlowRingWriter();

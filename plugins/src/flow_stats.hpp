@@ -28,8 +28,8 @@ class FlowStats {
   std::uint64_t processed() const { return processed_; }  // frames that left, with or without flow
   std::uint64_t flows() const { return flows_; }          // frames that left with flow
   std::uint64_t frames_dropped() const { return dropped_; }
-  double mean_latency_ms() const;                          // mean inference time of the flows
-  double processing_rate(Clock::time_point now) const;     // frames out per second since restart
+  double mean_latency_ms() const;                       // mean inference time of the flows
+  double processing_rate(Clock::time_point now) const;  // frames out per second since restart
   // What latency to report per frame: a moving average of recent inference times, the value
   // last announced (0 before the first flow).
   double announced_latency() const { return announced_latency_; }

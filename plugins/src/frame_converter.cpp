@@ -38,7 +38,8 @@ model::ImageView FrameConverter::view(GstVideoFrame& frame) {
       gst_buffer_new_wrapped_full(GST_MEMORY_FLAG_NO_SHARE, rgb_.data(), rgb_.size(), 0, rgb_.size(), nullptr, nullptr);
   gst_video_frame_map(&out, &rgb_info, wrapped, GST_MAP_WRITE);
   gst_video_converter_frame(converter_, &frame, &out);
-  const model::ImageView view{rgb_.data(), width, height, GST_VIDEO_FRAME_PLANE_STRIDE(&out, 0), model::ChannelOrder::rgb};
+  const model::ImageView view{rgb_.data(), width, height, GST_VIDEO_FRAME_PLANE_STRIDE(&out, 0),
+                              model::ChannelOrder::rgb};
   gst_video_frame_unmap(&out);
   gst_buffer_unref(wrapped);
   return view;

@@ -128,8 +128,8 @@ struct State {
   std::mutex tasks_lock;
   bool active = false;  // the src pad is active and its tasks are ours to pause and restart
 
-  std::mutex lock;                   // guards what follows, up to the worker-only state
-  std::optional<bool> live;          // resolved from the behaviour and upstream's liveness
+  std::mutex lock;           // guards what follows, up to the worker-only state
+  std::optional<bool> live;  // resolved from the behaviour and upstream's liveness
   GstSegment segment{};
   neuflow::gst::FlowStats stats;
   guint64 next_frame = 0;
@@ -335,8 +335,9 @@ GstFlowReturn deliver_oldest(GstNeuflow *self, State &st, const Settings &settin
 
   GstBuffer *buffer = f.buffer;
   if (flow) {
-    buffer = neuflow::gst::attach_flow(buffer, *flow, {f.previous_pts, GST_BUFFER_PTS(buffer), f.previous_frame, f.frame},
-                                       st.session->options(), seconds);
+    buffer =
+        neuflow::gst::attach_flow(buffer, *flow, {f.previous_pts, GST_BUFFER_PTS(buffer), f.previous_frame, f.frame},
+                                  st.session->options(), seconds);
   }
 
   bool post = false, announce = false;
@@ -395,10 +396,12 @@ void inference_loop(gpointer data) {
       ret = deliver_oldest(self, st, settings);
     }
     if (ret == GST_FLOW_OK && !st.in_flight.empty()) {
-      GST_LOG_OBJECT(self, "frame %" G_GUINT64_FORMAT " in flight while the next one goes up", st.in_flight.back().frame);
+      GST_LOG_OBJECT(self, "frame %" G_GUINT64_FORMAT " in flight while the next one goes up",
+                     st.in_flight.back().frame);
     }
   } else {
-    while (ret == GST_FLOW_OK && !st.in_flight.empty()) ret = deliver_oldest(self, st, settings);  // events keep their place
+    while (ret == GST_FLOW_OK && !st.in_flight.empty())
+      ret = deliver_oldest(self, st, settings);  // events keep their place
   }
   if (!item.buffer && ret != GST_FLOW_OK) {
     gst_event_unref(item.event);
@@ -472,10 +475,9 @@ bool upstream_is_live(GstNeuflow *self) {
 
 void post_drop(GstNeuflow *self, GstBuffer *dropped, const GstSegment &segment, guint64 processed, guint64 drops) {
   const GstClockTime pts = GST_BUFFER_PTS(dropped);
-  GstMessage *msg = gst_message_new_qos(GST_OBJECT(self), TRUE,
-                                        gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts),
-                                        gst_segment_to_stream_time(&segment, GST_FORMAT_TIME, pts), pts,
-                                        GST_BUFFER_DURATION(dropped));
+  GstMessage *msg = gst_message_new_qos(
+      GST_OBJECT(self), TRUE, gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts),
+      gst_segment_to_stream_time(&segment, GST_FORMAT_TIME, pts), pts, GST_BUFFER_DURATION(dropped));
   gst_message_set_qos_stats(msg, GST_FORMAT_BUFFERS, processed, drops);
   gst_element_post_message(GST_ELEMENT(self), msg);
 }
@@ -739,20 +741,46 @@ void set_property(GObject *object, guint id, const GValue *value, GParamSpec *ps
   GST_OBJECT_LOCK(self);
   Settings &s = *self->settings;
   switch (id) {
-    case PROP_MODEL: s.model = g_value_get_string(value) ? g_value_get_string(value) : ""; break;
+    case PROP_MODEL:
+      s.model = g_value_get_string(value) ? g_value_get_string(value) : "";
+      break;
     // The param specs' ranges keep each value within int.
-    case PROP_ITERS_S16: s.session.iterations.s16 = static_cast<int>(g_value_get_uint(value)); break;
-    case PROP_ITERS_S8: s.session.iterations.s8 = static_cast<int>(g_value_get_uint(value)); break;
-    case PROP_MODEL_WIDTH: s.session.model_width = static_cast<int>(g_value_get_uint(value)); break;
-    case PROP_MODEL_HEIGHT: s.session.model_height = static_cast<int>(g_value_get_uint(value)); break;
-    case PROP_THREADS: s.session.threads = static_cast<int>(g_value_get_uint(value)); break;
-    case PROP_CHANNEL_ORDER: s.session.network_order = static_cast<ChannelOrder>(g_value_get_enum(value)); break;
-    case PROP_BACKEND: s.session.backend = static_cast<neuflow::model::Backend>(g_value_get_enum(value)); break;
-    case PROP_DEVICE: s.session.device = g_value_get_int(value); break;
-    case PROP_PRECISION: s.session.precision = static_cast<neuflow::model::Precision>(g_value_get_enum(value)); break;
-    case PROP_BEHAVIOUR: s.behaviour = static_cast<Behaviour>(g_value_get_enum(value)); break;
-    case PROP_STATS_INTERVAL: s.stats_interval = g_value_get_uint(value); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_ITERS_S16:
+      s.session.iterations.s16 = static_cast<int>(g_value_get_uint(value));
+      break;
+    case PROP_ITERS_S8:
+      s.session.iterations.s8 = static_cast<int>(g_value_get_uint(value));
+      break;
+    case PROP_MODEL_WIDTH:
+      s.session.model_width = static_cast<int>(g_value_get_uint(value));
+      break;
+    case PROP_MODEL_HEIGHT:
+      s.session.model_height = static_cast<int>(g_value_get_uint(value));
+      break;
+    case PROP_THREADS:
+      s.session.threads = static_cast<int>(g_value_get_uint(value));
+      break;
+    case PROP_CHANNEL_ORDER:
+      s.session.network_order = static_cast<ChannelOrder>(g_value_get_enum(value));
+      break;
+    case PROP_BACKEND:
+      s.session.backend = static_cast<neuflow::model::Backend>(g_value_get_enum(value));
+      break;
+    case PROP_DEVICE:
+      s.session.device = g_value_get_int(value);
+      break;
+    case PROP_PRECISION:
+      s.session.precision = static_cast<neuflow::model::Precision>(g_value_get_enum(value));
+      break;
+    case PROP_BEHAVIOUR:
+      s.behaviour = static_cast<Behaviour>(g_value_get_enum(value));
+      break;
+    case PROP_STATS_INTERVAL:
+      s.stats_interval = g_value_get_uint(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -764,35 +792,75 @@ void get_property(GObject *object, guint id, GValue *value, GParamSpec *pspec) {
     const std::lock_guard lock(st.lock);
     const neuflow::gst::FlowStats &s = st.stats;
     switch (id) {
-      case PROP_FRAMES_IN: g_value_set_uint64(value, s.frames_in()); break;
-      case PROP_FRAMES_PROCESSED: g_value_set_uint64(value, s.processed()); break;
-      case PROP_FLOWS: g_value_set_uint64(value, s.flows()); break;
-      case PROP_FRAMES_DROPPED: g_value_set_uint64(value, s.frames_dropped()); break;
-      case PROP_MEAN_LATENCY: g_value_set_double(value, s.mean_latency_ms()); break;
+      case PROP_FRAMES_IN:
+        g_value_set_uint64(value, s.frames_in());
+        break;
+      case PROP_FRAMES_PROCESSED:
+        g_value_set_uint64(value, s.processed());
+        break;
+      case PROP_FLOWS:
+        g_value_set_uint64(value, s.flows());
+        break;
+      case PROP_FRAMES_DROPPED:
+        g_value_set_uint64(value, s.frames_dropped());
+        break;
+      case PROP_MEAN_LATENCY:
+        g_value_set_double(value, s.mean_latency_ms());
+        break;
       case PROP_PROCESSING_RATE:
         g_value_set_double(value, s.processing_rate(std::chrono::steady_clock::now()));
         break;
-      default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+      default:
+        G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+        break;
     }
     return;
   }
   GST_OBJECT_LOCK(self);
   const Settings &s = *self->settings;
   switch (id) {
-    case PROP_MODEL: g_value_set_string(value, s.model.c_str()); break;
-    case PROP_ITERS_S16: g_value_set_uint(value, static_cast<guint>(s.session.iterations.s16)); break;
-    case PROP_ITERS_S8: g_value_set_uint(value, static_cast<guint>(s.session.iterations.s8)); break;
-    case PROP_MODEL_WIDTH: g_value_set_uint(value, static_cast<guint>(s.session.model_width)); break;
-    case PROP_MODEL_HEIGHT: g_value_set_uint(value, static_cast<guint>(s.session.model_height)); break;
-    case PROP_THREADS: g_value_set_uint(value, static_cast<guint>(s.session.threads)); break;
-    case PROP_CHANNEL_ORDER: g_value_set_enum(value, static_cast<gint>(s.session.network_order)); break;
-    case PROP_BACKEND: g_value_set_enum(value, static_cast<gint>(s.session.backend)); break;
-    case PROP_DEVICE: g_value_set_int(value, s.session.device); break;
-    case PROP_PRECISION: g_value_set_enum(value, static_cast<gint>(s.session.precision)); break;
-    case PROP_RUNNING_ON: g_value_set_string(value, s.running_on.c_str()); break;
-    case PROP_BEHAVIOUR: g_value_set_enum(value, static_cast<gint>(s.behaviour)); break;
-    case PROP_STATS_INTERVAL: g_value_set_uint(value, s.stats_interval); break;
-    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
+    case PROP_MODEL:
+      g_value_set_string(value, s.model.c_str());
+      break;
+    case PROP_ITERS_S16:
+      g_value_set_uint(value, static_cast<guint>(s.session.iterations.s16));
+      break;
+    case PROP_ITERS_S8:
+      g_value_set_uint(value, static_cast<guint>(s.session.iterations.s8));
+      break;
+    case PROP_MODEL_WIDTH:
+      g_value_set_uint(value, static_cast<guint>(s.session.model_width));
+      break;
+    case PROP_MODEL_HEIGHT:
+      g_value_set_uint(value, static_cast<guint>(s.session.model_height));
+      break;
+    case PROP_THREADS:
+      g_value_set_uint(value, static_cast<guint>(s.session.threads));
+      break;
+    case PROP_CHANNEL_ORDER:
+      g_value_set_enum(value, static_cast<gint>(s.session.network_order));
+      break;
+    case PROP_BACKEND:
+      g_value_set_enum(value, static_cast<gint>(s.session.backend));
+      break;
+    case PROP_DEVICE:
+      g_value_set_int(value, s.session.device);
+      break;
+    case PROP_PRECISION:
+      g_value_set_enum(value, static_cast<gint>(s.session.precision));
+      break;
+    case PROP_RUNNING_ON:
+      g_value_set_string(value, s.running_on.c_str());
+      break;
+    case PROP_BEHAVIOUR:
+      g_value_set_enum(value, static_cast<gint>(s.behaviour));
+      break;
+    case PROP_STATS_INTERVAL:
+      g_value_set_uint(value, s.stats_interval);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec);
+      break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -818,14 +886,14 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
   gobject_class->finalize = finalize;
   element_class->change_state = change_state;
 
-  constexpr auto rw = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                               GST_PARAM_MUTABLE_READY);
+  constexpr auto rw = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
   constexpr auto ro = static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS);
   // The model is loaded when the element leaves NULL, so it can only change in NULL.
   constexpr auto rw_null = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS);
   g_object_class_install_property(
       gobject_class, PROP_MODEL,
-      g_param_spec_string("model", "Model", "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth; loaded once when "
+      g_param_spec_string("model", "Model",
+                          "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth; loaded once when "
                           "the element leaves NULL and shared with other elements using the same file",
                           nullptr, rw_null));
   g_object_class_install_property(
@@ -846,10 +914,9 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
       g_param_spec_uint("model-height", "Model height",
                         "Height the network runs at (multiple of 16); 0: the frame's own size, edge-padded", 0,
                         SessionLimits::max_side, DEFAULT_SESSION.model_height, rw));
-  g_object_class_install_property(
-      gobject_class, PROP_THREADS,
-      g_param_spec_uint("threads", "Threads", "CPU threads for inference (0: all cores)", 0,
-                        SessionLimits::max_threads, DEFAULT_SESSION.threads, rw));
+  g_object_class_install_property(gobject_class, PROP_THREADS,
+                                  g_param_spec_uint("threads", "Threads", "CPU threads for inference (0: all cores)", 0,
+                                                    SessionLimits::max_threads, DEFAULT_SESSION.threads, rw));
   g_object_class_install_property(
       gobject_class, PROP_CHANNEL_ORDER,
       g_param_spec_enum("channel-order", "Channel order", "Colour order fed to the network", channel_order_get_type(),
@@ -882,19 +949,19 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
                         behaviour_get_type(), static_cast<gint>(Behaviour::automatic), rw));
   g_object_class_install_property(
       gobject_class, PROP_STATS_INTERVAL,
-      g_param_spec_uint("stats-interval", "Stats interval",
-                        "Milliseconds between 'neuflow-stats' element messages carrying the counters (0: none)", 0,
-                        G_MAXUINT, DEFAULT_STATS_INTERVAL,
-                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                                 GST_PARAM_MUTABLE_PLAYING)));
+      g_param_spec_uint(
+          "stats-interval", "Stats interval",
+          "Milliseconds between 'neuflow-stats' element messages carrying the counters (0: none)", 0, G_MAXUINT,
+          DEFAULT_STATS_INTERVAL,
+          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
   g_object_class_install_property(
       gobject_class, PROP_FRAMES_IN,
       g_param_spec_uint64("frames-in", "Frames in", "Frames received", 0, G_MAXUINT64, 0, ro));
   g_object_class_install_property(
       gobject_class, PROP_FRAMES_PROCESSED,
       g_param_spec_uint64("frames-processed", "Frames processed",
-                          "Frames computed, the first of a stream (which has no flow yet) included", 0, G_MAXUINT64,
-                          0, ro));
+                          "Frames computed, the first of a stream (which has no flow yet) included", 0, G_MAXUINT64, 0,
+                          ro));
   g_object_class_install_property(
       gobject_class, PROP_FLOWS,
       g_param_spec_uint64("flows", "Flows",
@@ -907,12 +974,11 @@ static void gst_neuflow_class_init(GstNeuflowClass *klass) {
                           G_MAXUINT64, 0, ro));
   g_object_class_install_property(
       gobject_class, PROP_MEAN_LATENCY,
-      g_param_spec_double("mean-latency", "Mean latency", "Mean inference time per flow, milliseconds", 0,
-                          G_MAXDOUBLE, 0, ro));
-  g_object_class_install_property(
-      gobject_class, PROP_PROCESSING_RATE,
-      g_param_spec_double("processing-rate", "Processing rate", "Frames leaving the element per second", 0,
-                          G_MAXDOUBLE, 0, ro));
+      g_param_spec_double("mean-latency", "Mean latency", "Mean inference time per flow, milliseconds", 0, G_MAXDOUBLE,
+                          0, ro));
+  g_object_class_install_property(gobject_class, PROP_PROCESSING_RATE,
+                                  g_param_spec_double("processing-rate", "Processing rate",
+                                                      "Frames leaving the element per second", 0, G_MAXDOUBLE, 0, ro));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);

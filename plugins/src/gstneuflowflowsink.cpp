@@ -103,11 +103,11 @@ static GstFlowReturn gst_neuflow_flow_sink_render(GstBaseSink *sink, GstBuffer *
   const gsize have = meta->data ? g_bytes_get_size(meta->data) : 0;
   const guint64 need = static_cast<guint64>(meta->width) * meta->height * 2 * sizeof(gfloat);
   if (have < need) {
-    GST_ELEMENT_ERROR(self, STREAM, FORMAT,
-                      ("Flow metadata of a %ux%u grid holds %" G_GSIZE_FORMAT " bytes of vectors, expected %" G_GUINT64_FORMAT
-                       ".",
-                       meta->width, meta->height, have, need),
-                      ("buffer %" GST_TIME_FORMAT, GST_TIME_ARGS(GST_BUFFER_PTS(buffer))));
+    GST_ELEMENT_ERROR(
+        self, STREAM, FORMAT,
+        ("Flow metadata of a %ux%u grid holds %" G_GSIZE_FORMAT " bytes of vectors, expected %" G_GUINT64_FORMAT ".",
+         meta->width, meta->height, have, need),
+        ("buffer %" GST_TIME_FORMAT, GST_TIME_ARGS(GST_BUFFER_PTS(buffer))));
     return GST_FLOW_ERROR;
   }
 

@@ -25,8 +25,7 @@ struct _GstNeuflowFlowSinkClass {
   // Writes one flow whose meta holds width × height × 2 floats and sets `bytes` to what that
   // put out (the file's size, the vectors published); on failure posts an element error and
   // returns GST_FLOW_ERROR. Counted as written when it returns GST_FLOW_OK.
-  GstFlowReturn (*write_flow)(GstNeuflowFlowSink *sink, GstBuffer *buffer, const NeuflowFlowMeta *meta,
-                              guint64 *bytes);
+  GstFlowReturn (*write_flow)(GstNeuflowFlowSink *sink, GstBuffer *buffer, const NeuflowFlowMeta *meta, guint64 *bytes);
   // Releases what start_writing opened; may be called without a start_writing before it.
   void (*stop_writing)(GstNeuflowFlowSink *sink);
   // What the subclass writes, for the log: "flow files", "flows into the ring".

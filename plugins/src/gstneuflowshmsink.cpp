@@ -81,8 +81,7 @@ G_DEFINE_TYPE_WITH_CODE(GstNeuflowShmSink, gst_neuflow_shm_sink, GST_TYPE_NEUFLO
                         GST_DEBUG_CATEGORY_INIT(gst_neuflow_shm_sink_debug, "neuflowshmsink", 0,
                                                 "NeuFlow optical flow shared-memory ring writer"))
 
-static void gst_neuflow_shm_sink_set_property(GObject *object, guint prop_id, const GValue *value,
-                                              GParamSpec *pspec) {
+static void gst_neuflow_shm_sink_set_property(GObject *object, guint prop_id, const GValue *value, GParamSpec *pspec) {
   GstNeuflowShmSink *self = GST_NEUFLOW_SHM_SINK(object);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
@@ -159,8 +158,8 @@ static gboolean gst_neuflow_shm_sink_start_writing(GstNeuflowFlowSink *sink) {
   }
 
   if (auto problem = neuflow::gst::check_flow_ring_mode(mode)) {
-    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS, ("Invalid shm-mode %04o: %s.", static_cast<unsigned>(mode), problem->c_str()),
-                      (nullptr));
+    GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS,
+                      ("Invalid shm-mode %04o: %s.", static_cast<unsigned>(mode), problem->c_str()), (nullptr));
     return FALSE;
   }
 
@@ -182,7 +181,7 @@ static void gst_neuflow_shm_sink_stop_writing(GstNeuflowFlowSink *sink) {
 }
 
 static GstFlowReturn gst_neuflow_shm_sink_write_flow(GstNeuflowFlowSink *sink, GstBuffer * /*buffer*/,
-                                                    const NeuflowFlowMeta *meta, guint64 *bytes) {
+                                                     const NeuflowFlowMeta *meta, guint64 *bytes) {
   GstNeuflowShmSink *self = GST_NEUFLOW_SHM_SINK(sink);
   const std::size_t values = static_cast<std::size_t>(meta->width) * meta->height * 2;
 
@@ -224,7 +223,8 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
   gobject_class->get_property = gst_neuflow_shm_sink_get_property;
   gobject_class->finalize = gst_neuflow_shm_sink_finalize;
 
-  constexpr auto rw_ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
+  constexpr auto rw_ready =
+      static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
 
   g_object_class_install_property(
       gobject_class, PROP_SHM_NAME,
@@ -247,11 +247,11 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
                         "readers as that user or in that group. Read and write bits only, the owner's included",
                         0600, 0666, DEFAULT_PROP_SHM_MODE, rw_ready));
 
-  gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow shared-memory sink",
-                                        "Sink/Video/Analyzer",
-                                        "Publishes the optical flow attached to video frames (NeuflowFlowMeta) into "
-                                        "a POSIX shared-memory ring of the latest flows, for readers in other processes",
-                                        "neuflow");
+  gst_element_class_set_static_metadata(
+      element_class, "NeuFlow optical flow shared-memory sink", "Sink/Video/Analyzer",
+      "Publishes the optical flow attached to video frames (NeuflowFlowMeta) into "
+      "a POSIX shared-memory ring of the latest flows, for readers in other processes",
+      "neuflow");
   gst_element_class_add_static_metadata(element_class, GST_ELEMENT_METADATA_DOC_URI, NEUFLOW_DOC_URI);
   flow_sink_class->start_writing = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_start_writing);
   flow_sink_class->write_flow = GST_DEBUG_FUNCPTR(gst_neuflow_shm_sink_write_flow);

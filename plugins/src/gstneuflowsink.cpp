@@ -90,24 +90,24 @@ struct GstNeuflowSink {
   // Properties, under the object lock.
   gchar *location;
   gchar *index_location;
-  gint index;  // of the next file
+  gint index;         // of the next file
   guint64 max_files;  // 0: no limit
   guint64 max_bytes;
 
   // From start() to stop(), streaming thread only.
-  gchar *pattern;          // location, validated
-  gchar *index_path;       // where the index goes, or nullptr when disabled
-  gchar *index_dir;        // its directory, to name files beside it by their base name
-  FILE *index_file;        // opened at the first flow written
+  gchar *pattern;     // location, validated
+  gchar *index_path;  // where the index goes, or nullptr when disabled
+  gchar *index_dir;   // its directory, to name files beside it by their base name
+  FILE *index_file;   // opened at the first flow written
 
   // Retention, streaming thread only. Files are tracked only while a limit is set: without
   // one, a weeks-long run would otherwise keep one entry per flow in memory.
   neuflow::gst::WrittenFiles *written;  // files of this run, oldest first
   guint64 index_rows;                   // data rows in the index file, once counted
   gboolean index_rows_known;
-  guint64 index_foreign_rows;           // rows of files not in `written` (earlier runs), at most
-  guint64 index_compact_floor;          // no compaction below this many rows (after a failure)
-  guint64 files_removed;                // since the last compaction
+  guint64 index_foreign_rows;   // rows of files not in `written` (earlier runs), at most
+  guint64 index_compact_floor;  // no compaction below this many rows (after a failure)
+  guint64 files_removed;        // since the last compaction
 };
 
 struct GstNeuflowSinkClass {
@@ -273,7 +273,8 @@ static void gst_neuflow_sink_remove_excess(GstNeuflowSink *self, guint64 max_fil
 // set, the files the pattern names count towards it (oldest index first), so a restarted or
 // reconfigured stream holds max-files / max-bytes over everything in the folder.
 static void gst_neuflow_sink_take_over_earlier_files(GstNeuflowSink *self) {
-  for (const std::string &path : neuflow::gst::remove_stale_temporaries(self->pattern, self->index_path ? self->index_path : "")) {
+  for (const std::string &path :
+       neuflow::gst::remove_stale_temporaries(self->pattern, self->index_path ? self->index_path : "")) {
     GST_INFO_OBJECT(self, "removed %s, left by an interrupted write", path.c_str());
   }
   GST_OBJECT_LOCK(self);
@@ -363,10 +364,10 @@ static void gst_neuflow_sink_compact_index(GstNeuflowSink *self) {
     GST_DEBUG_OBJECT(self, "index %s compacted: kept %zu rows, dropped %zu", self->index_path, result.rows_kept,
                      result.rows_dropped);
   } catch (const std::exception &e) {
-    GST_ELEMENT_WARNING(self, RESOURCE, WRITE,
-                        ("Could not remove the rows of deleted flow files from the index \"%s\": %s.", self->index_path,
-                         e.what()),
-                        (nullptr));
+    GST_ELEMENT_WARNING(
+        self, RESOURCE, WRITE,
+        ("Could not remove the rows of deleted flow files from the index \"%s\": %s.", self->index_path, e.what()),
+        (nullptr));
     self->index_compact_floor = 2 * self->index_rows;
   }
 }
@@ -468,8 +469,7 @@ static bool gst_neuflow_sink_append_index(GstNeuflowSink *self, gint index, cons
   if (std::fputs(row.c_str(), self->index_file) == EOF || std::fflush(self->index_file) != 0) {
     const int err = errno;
     GST_ELEMENT_ERROR(self, RESOURCE, WRITE,
-                      ("Could not append to the flow index \"%s\": %s.", self->index_path, g_strerror(err)),
-                      (nullptr));
+                      ("Could not append to the flow index \"%s\": %s.", self->index_path, g_strerror(err)), (nullptr));
     return false;
   }
   ++self->index_rows;
@@ -491,7 +491,8 @@ static GstFlowReturn gst_neuflow_sink_write_flow(GstNeuflowFlowSink *sink, GstBu
     std::memcpy(field.uv.data(), vectors, field.uv.size() * sizeof(float));
     neuflow::flow::write_flow(field, path);
   } catch (const neuflow::flow::FlowFileError &e) {
-    GST_ELEMENT_ERROR(self, RESOURCE, WRITE, ("Could not write the flow file \"%s\": %s.", path.c_str(), e.problem().c_str()),
+    GST_ELEMENT_ERROR(self, RESOURCE, WRITE,
+                      ("Could not write the flow file \"%s\": %s.", path.c_str(), e.problem().c_str()),
                       ("%s", e.what()));
     return GST_FLOW_ERROR;
   } catch (const std::exception &e) {
@@ -499,8 +500,8 @@ static GstFlowReturn gst_neuflow_sink_write_flow(GstNeuflowFlowSink *sink, GstBu
                       (nullptr));
     return GST_FLOW_ERROR;
   }
-  GST_LOG_OBJECT(self, "wrote %s: %ux%u, frames %" G_GUINT64_FORMAT " -> %" G_GUINT64_FORMAT, path.c_str(),
-                 meta->width, meta->height, meta->from_frame, meta->to_frame);
+  GST_LOG_OBJECT(self, "wrote %s: %ux%u, frames %" G_GUINT64_FORMAT " -> %" G_GUINT64_FORMAT, path.c_str(), meta->width,
+                 meta->height, meta->from_frame, meta->to_frame);
   // Measured before retention may delete the file again.
   std::error_code size_error;
   const auto size = std::filesystem::file_size(path, size_error);
@@ -524,7 +525,8 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
   gobject_class->get_property = gst_neuflow_sink_get_property;
   gobject_class->finalize = gst_neuflow_sink_finalize;
 
-  constexpr auto rw_ready = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
+  constexpr auto rw_ready =
+      static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_READY);
 
   g_object_class_install_property(
       gobject_class, PROP_LOCATION,
@@ -535,39 +537,44 @@ static void gst_neuflow_sink_class_init(GstNeuflowSinkClass *klass) {
                           DEFAULT_PROP_LOCATION, rw_ready));
   g_object_class_install_property(
       gobject_class, PROP_INDEX,
-      g_param_spec_int("index", "Index",
-                       "Index of the next flow file in the location pattern; incremented after each file written "
-                       "(buffers without flow do not use an index)",
-                       0, G_MAXINT, DEFAULT_PROP_INDEX,
-                       static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
+      g_param_spec_int(
+          "index", "Index",
+          "Index of the next flow file in the location pattern; incremented after each file written "
+          "(buffers without flow do not use an index)",
+          0, G_MAXINT, DEFAULT_PROP_INDEX,
+          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
   g_object_class_install_property(
       gobject_class, PROP_INDEX_LOCATION,
-      g_param_spec_string("index-location", "Index file location",
-                          "CSV file that gets one row per flow file, flushed at once: "
-                          "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source (timestamps in ns, "
-                          "empty when unknown; sources always empty here, the format is shared with neuflow convert; file by its base name when it lies beside the index, else as written). Rows are "
-                          "appended; the header is written into an empty file. With max-files or max-bytes set, the "
-                          "index is rewritten atomically with only the rows of files still on disk whenever it holds "
-                          "more than twice as many rows as files kept (at least 32 rows), and when the element "
-                          "stops, so it stays bounded. Unset: index.csv in the directory of location; empty string: "
-                          "no index",
-                          DEFAULT_PROP_INDEX_LOCATION, rw_ready));
+      g_param_spec_string(
+          "index-location", "Index file location",
+          "CSV file that gets one row per flow file, flushed at once: "
+          "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source (timestamps in ns, "
+          "empty when unknown; sources always empty here, the format is shared with neuflow convert; file by its base "
+          "name when it lies beside the index, else as written). Rows are "
+          "appended; the header is written into an empty file. With max-files or max-bytes set, the "
+          "index is rewritten atomically with only the rows of files still on disk whenever it holds "
+          "more than twice as many rows as files kept (at least 32 rows), and when the element "
+          "stops, so it stays bounded. Unset: index.csv in the directory of location; empty string: "
+          "no index",
+          DEFAULT_PROP_INDEX_LOCATION, rw_ready));
   g_object_class_install_property(
       gobject_class, PROP_MAX_FILES,
-      g_param_spec_uint64("max-files", "Maximum files",
-                          "Keep at most this many flow files: after each file written, the oldest files this element "
-                          "wrote since it started (not those of earlier runs, nor those written while no limit was "
-                          "set) are deleted, oldest first, and their index rows dropped. 0: no limit",
-                          0, G_MAXUINT64, DEFAULT_PROP_MAX_FILES,
-                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
+      g_param_spec_uint64(
+          "max-files", "Maximum files",
+          "Keep at most this many flow files: after each file written, the oldest files this element "
+          "wrote since it started (not those of earlier runs, nor those written while no limit was "
+          "set) are deleted, oldest first, and their index rows dropped. 0: no limit",
+          0, G_MAXUINT64, DEFAULT_PROP_MAX_FILES,
+          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
   g_object_class_install_property(
       gobject_class, PROP_MAX_BYTES,
-      g_param_spec_uint64("max-bytes", "Maximum bytes",
-                          "Keep the flow files at most this many bytes in all, deleting the oldest as for max-files "
-                          "(both limits hold when both are set); the newest file is always kept, even when it alone "
-                          "is larger. 0: no limit",
-                          0, G_MAXUINT64, DEFAULT_PROP_MAX_BYTES,
-                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
+      g_param_spec_uint64(
+          "max-bytes", "Maximum bytes",
+          "Keep the flow files at most this many bytes in all, deleting the oldest as for max-files "
+          "(both limits hold when both are set); the newest file is always kept, even when it alone "
+          "is larger. 0: no limit",
+          0, G_MAXUINT64, DEFAULT_PROP_MAX_BYTES,
+          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS | GST_PARAM_MUTABLE_PLAYING)));
 
   gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow file sink", "Sink/File/Video/Analyzer",
                                         "Writes the optical flow attached to video frames (NeuflowFlowMeta) to "

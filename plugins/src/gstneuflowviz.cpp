@@ -118,7 +118,7 @@ using ComposeFunction = void (*)(GstVideoFrame *frame, const PixelLayout &px, co
 // that draw into it; chosen once per caps in set_info.
 struct PixelLayout {
   int r = 0, g = 1, b = 2;
-  int stride = 3;  // bytes per pixel
+  int stride = 3;                     // bytes per pixel
   ComposeFunction replace = nullptr;  // flow mode
   ComposeFunction overlay = nullptr;  // overlay mode
 };
@@ -129,8 +129,8 @@ struct VizScratch {
   neuflow::flow::FlowField field;
   std::vector<int> x0, x1, wx;  // column -> grid columns and weight of x1 (0..256)
   std::vector<int> y0, y1, wy;  // the same for rows
-  std::vector<int> row;          // one output row's blend of its two grid rows, RGB
-  cv::Mat arrow_mask;            // the arrows' anti-aliased coverage, 0..255
+  std::vector<int> row;         // one output row's blend of its two grid rows, RGB
+  cv::Mat arrow_mask;           // the arrows' anti-aliased coverage, 0..255
 };
 
 }  // namespace
@@ -420,9 +420,8 @@ static gboolean gst_neuflow_viz_set_info(GstVideoFilter *filter, GstCaps * /*inc
     GST_ERROR_OBJECT(self, "unsupported pixel size %d in %s", self->layout.stride, GST_VIDEO_FORMAT_INFO_NAME(finfo));
     return FALSE;
   }
-  GST_DEBUG_OBJECT(self, "format %s: R at %d, G at %d, B at %d, %d bytes per pixel",
-                   GST_VIDEO_FORMAT_INFO_NAME(finfo), self->layout.r, self->layout.g, self->layout.b,
-                   self->layout.stride);
+  GST_DEBUG_OBJECT(self, "format %s: R at %d, G at %d, B at %d, %d bytes per pixel", GST_VIDEO_FORMAT_INFO_NAME(finfo),
+                   self->layout.r, self->layout.g, self->layout.b, self->layout.stride);
   return TRUE;
 }
 

@@ -22,9 +22,7 @@ void WrittenFiles::add(const std::string &path, std::uint64_t bytes) {
 
 std::vector<std::string> WrittenFiles::take_excess(std::uint64_t max_files, std::uint64_t max_bytes) {
   std::vector<std::string> excess;
-  auto over = [&] {
-    return (max_files > 0 && newest_.size() > max_files) || (max_bytes > 0 && bytes_ > max_bytes);
-  };
+  auto over = [&] { return (max_files > 0 && newest_.size() > max_files) || (max_bytes > 0 && bytes_ > max_bytes); };
   while (!entries_.empty() && (superseded(entries_.front()) || (over() && newest_.size() > 1))) {
     Entry e = std::move(entries_.front());
     entries_.pop_front();

@@ -33,10 +33,10 @@ class WrittenFiles {
   };
   bool superseded(const Entry &e) const;
 
-  std::deque<Entry> entries_;                                // oldest first, superseded ones included
-  std::unordered_map<std::string, std::uint64_t> newest_;    // path → serial of its live entry
+  std::deque<Entry> entries_;                              // oldest first, superseded ones included
+  std::unordered_map<std::string, std::uint64_t> newest_;  // path → serial of its live entry
   std::uint64_t next_serial_ = 0;
-  std::uint64_t bytes_ = 0;                                  // of live entries
+  std::uint64_t bytes_ = 0;  // of live entries
 };
 
 }  // namespace neuflow::gst

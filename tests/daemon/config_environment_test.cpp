@@ -14,9 +14,9 @@
 #include <set>
 #include <string>
 
+#include "checkpoint_builder.hpp"
 #include "config.hpp"
 #include "config_read.hpp"
-#include "checkpoint_builder.hpp"
 #include "config_test_util.hpp"
 #include "neuflow/model/gpu_devices.hpp"
 
@@ -338,9 +338,8 @@ TEST(ConfigMachine, AVulkanDeviceMustExist) {
   const auto issues = machine_issues(with_flow("backend = \"vulkan\", device = 63"), all, file);
   ASSERT_EQ(issues.size(), 1u) << test::listed(issues);
   if (have_vulkan) {
-    EXPECT_TRUE(has_issue(issues, 4, 56,
-                          "device: stream 's' asks for Vulkan device 63, but this machine has " +
-                              std::to_string(devices)))
+    EXPECT_TRUE(has_issue(
+        issues, 4, 56, "device: stream 's' asks for Vulkan device 63, but this machine has " + std::to_string(devices)))
         << test::listed(issues);
     EXPECT_TRUE(machine_issues(with_flow("backend = \"vulkan\", device = 0"), all, file).empty());
   } else {

@@ -132,7 +132,8 @@ sink = [ { type = "display" } ]
   EXPECT_EQ(std::get<V4l2Source>(front.source.settings),
             (V4l2Source{"/dev/video2", VideoMode{1280, 720, 30000, 1001}, true}));
   EXPECT_EQ(front.source.where.line, 18);
-  EXPECT_EQ(front.flow, (FlowConfig{"/var/lib/neuflow/neuflow_mixed.pth", 2, 6, 640, 352, 3, "live", "bgr", "cpu", 0, "fp32", {}}));
+  EXPECT_EQ(front.flow,
+            (FlowConfig{"/var/lib/neuflow/neuflow_mixed.pth", 2, 6, 640, 352, 3, "live", "bgr", "cpu", 0, "fp32", {}}));
   EXPECT_EQ(front.flow.where.line, 25);
   ASSERT_EQ(front.sinks.size(), 4u);
   EXPECT_EQ(front.sinks[0].name, "front-ring");
@@ -270,16 +271,20 @@ TEST(Config, ConfigIssueAndConfigErrorText) {
 
 TEST(ConfigValues, ShmModeIsOctalAsAStringOrATomlOctalInteger) {
   const auto mode_of = [](const std::string& value) {
-    const Config c = parse("[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
-                           "sink = [ { type = \"shm\", shm-name = \"/x\", shm-mode = " + value + " } ]\n");
+    const Config c = parse(
+        "[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
+        "sink = [ { type = \"shm\", shm-name = \"/x\", shm-mode = " +
+        value + " } ]\n");
     return std::get<ShmSink>(c.streams[0].sinks[0].settings).mode;
   };
   EXPECT_EQ(mode_of("\"0644\""), 0644u);
   EXPECT_EQ(mode_of("\"660\""), 0660u);
   EXPECT_EQ(mode_of("0o600"), 0600u);
   for (const std::string bad : {"\"0700\"", "\"0400\"", "\"rw-r-----\"", "644", "\"04640\""}) {
-    const auto issues = issues_of("[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
-                                  "sink = [ { type = \"shm\", shm-name = \"/x\", shm-mode = " + bad + " } ]\n");
+    const auto issues = issues_of(
+        "[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
+        "sink = [ { type = \"shm\", shm-name = \"/x\", shm-mode = " +
+        bad + " } ]\n");
     EXPECT_TRUE(has_issue(issues, 5, 0, "shm-mode: expected an octal mode like \"0640\"")) << bad;
   }
 }
@@ -858,14 +863,15 @@ namespace {
 TEST(ConfigValues, ShmNameAndModeFollowTheRingsOwnRules) {
   const auto shm_sink = [](const std::string& name) {
     return "[[stream]]\nname = \"s\"\nsource = { type = \"test\" }\nflow = { model = \"/m.pth\" }\n"
-           "sink = [ { type = \"shm\", shm-name = \"" + name + "\" } ]\n";
+           "sink = [ { type = \"shm\", shm-name = \"" +
+           name + "\" } ]\n";
   };
   for (const std::string& good : {"/" + std::string(ring::kMaxSegmentNameLength, 'a'), std::string("/cam@front+2")}) {
     EXPECT_TRUE(ring::segment_name_problem(good).empty()) << good;
     EXPECT_EQ(std::get<ShmSink>(parse(shm_sink(good)).streams[0].sinks[0].settings).name, good);
   }
   for (const std::string& bad : {"/" + std::string(ring::kMaxSegmentNameLength + 1, 'a'), std::string("/a/b"),
-                                std::string("/.."), std::string("noslash")}) {
+                                 std::string("/.."), std::string("noslash")}) {
     EXPECT_FALSE(ring::segment_name_problem(bad).empty()) << bad;
     EXPECT_TRUE(has_issue(issues_of(shm_sink(bad)), 5, 0, "shm-name: expected a name like \"/neuflow-front\" ("))
         << bad;

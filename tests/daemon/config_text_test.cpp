@@ -109,7 +109,8 @@ TEST(ConfigText, NonAsciiInStringsAndCommentsAndWindowsLineEndingsAreFine) {
   text += "[metrics] # m\xc3\xa9triques\n";
   text += "listen = '127.0.0.1:9464' # \xf0\x9f\x93\x88\n";
   EXPECT_TRUE(issues_of(text).empty()) << test::listed(issues_of(text));
-  EXPECT_FALSE(check_config_text("s = \"\"\"\n\xc3\xa9\\\n  x \xc3\xa9\"\"\"\nt = '''\xc3\xa9'''\nu = \"\\\"\xc3\xa9\"\n"));
+  EXPECT_FALSE(
+      check_config_text("s = \"\"\"\n\xc3\xa9\\\n  x \xc3\xa9\"\"\"\nt = '''\xc3\xa9'''\nu = \"\\\"\xc3\xa9\"\n"));
 }
 
 TEST(ConfigText, ColumnsCountCharactersNotBytes) {
@@ -119,7 +120,11 @@ TEST(ConfigText, ColumnsCountCharactersNotBytes) {
   EXPECT_EQ(problem->column, 10);
 }
 
-TEST(ConfigText, AByteOrderMarkIsAllowed) { EXPECT_FALSE(check_config_text("\xEF\xBB\xBF" "a = 1\n")); }
+TEST(ConfigText, AByteOrderMarkIsAllowed) {
+  EXPECT_FALSE(
+      check_config_text("\xEF\xBB\xBF"
+                        "a = 1\n"));
+}
 
 }  // namespace
 }  // namespace neuflow::daemon

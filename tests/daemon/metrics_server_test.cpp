@@ -140,8 +140,8 @@ class RawClient {
 
   void send(const std::string& bytes) {
     GError* error = nullptr;
-    const gssize sent = g_socket_send(g_socket_connection_get_socket(connection_), bytes.data(), bytes.size(),
-                                      nullptr, &error);
+    const gssize sent =
+        g_socket_send(g_socket_connection_get_socket(connection_), bytes.data(), bytes.size(), nullptr, &error);
     if (error != nullptr) g_error_free(error);
     ASSERT_EQ(sent, static_cast<gssize>(bytes.size()));
   }
@@ -153,8 +153,8 @@ class RawClient {
         [&] {
           char buffer[4096];
           GError* error = nullptr;
-          const gssize n = g_socket_receive(g_socket_connection_get_socket(connection_), buffer, sizeof buffer,
-                                            nullptr, &error);
+          const gssize n =
+              g_socket_receive(g_socket_connection_get_socket(connection_), buffer, sizeof buffer, nullptr, &error);
           if (n > 0) {
             received.append(buffer, static_cast<size_t>(n));
             return false;
@@ -206,9 +206,9 @@ TEST(MetricsServer, AnswersCurl) {
   if (curl == nullptr) GTEST_SKIP() << "curl is not installed";
   MetricsServer server("127.0.0.1", 0, [] { return render_prometheus(one_stream(), 1.0, "1.0"); });
   GError* error = nullptr;
-  GSubprocess* child = g_subprocess_new(G_SUBPROCESS_FLAGS_STDOUT_PIPE, &error, curl, "--silent", "--show-error",
-                                        "--noproxy", "*", "--include", "--max-time", "5", server.url().c_str(),
-                                        nullptr);
+  GSubprocess* child =
+      g_subprocess_new(G_SUBPROCESS_FLAGS_STDOUT_PIPE, &error, curl, "--silent", "--show-error", "--noproxy", "*",
+                       "--include", "--max-time", "5", server.url().c_str(), nullptr);
   g_free(curl);
   ASSERT_NE(child, nullptr) << error->message;
   struct Result {
@@ -402,7 +402,8 @@ TEST(MetricsServer, DestroyingItClosesConnectedClients) {
 TEST(MetricsServer, ConnectionsBeyondTheCapCloseTheOldestAndScrapesStillAnswer) {
   MetricsServer::Limits limits;
   limits.max_connections = 4;
-  MetricsServer server("127.0.0.1", 0, [] { return std::string("x 1\n"); }, limits);
+  MetricsServer server(
+      "127.0.0.1", 0, [] { return std::string("x 1\n"); }, limits);
   const size_t before = open_descriptors();
   std::vector<std::unique_ptr<RawClient>> flood;
   for (int i = 0; i < 40; ++i) {
@@ -423,7 +424,8 @@ TEST(MetricsServer, ConnectionsBeyondTheCapCloseTheOldestAndScrapesStillAnswer) 
 TEST(MetricsServer, AConnectionThatSaysNothingIsClosedAfterTheIdleTimeout) {
   MetricsServer::Limits limits;
   limits.idle_timeout = 1000ms;
-  MetricsServer server("127.0.0.1", 0, [] { return std::string("x 1\n"); }, limits);
+  MetricsServer server(
+      "127.0.0.1", 0, [] { return std::string("x 1\n"); }, limits);
   RawClient silent(server.port());
   RawClient halfway(server.port());
   halfway.send("GET /metrics HTTP/1.1\r\nHost: 127.0.0.1\r\n");  // and never the blank line

@@ -147,7 +147,7 @@ TEST(PrometheusText, EscapesLabelValues) {
   EXPECT_EQ(escape_label_value("a\\b"), "a\\\\b");
   EXPECT_EQ(escape_label_value("say \"hi\""), "say \\\"hi\\\"");
   EXPECT_EQ(escape_label_value("two\nlines"), "two\\nlines");
-  EXPECT_EQ(escape_label_value("\\n"), "\\\\n");  // a literal backslash-n is not a newline
+  EXPECT_EQ(escape_label_value("\\n"), "\\\\n");                            // a literal backslash-n is not a newline
   EXPECT_EQ(escape_label_value("tab\tand \xc3\xa9"), "tab\tand \xc3\xa9");  // kept as is
 }
 
@@ -184,17 +184,24 @@ bool unescape(const std::string& escaped, std::string& out) {
     }
     if (++i == escaped.size()) return false;
     switch (escaped[i]) {
-      case '\\': out += '\\'; break;
-      case '"': out += '"'; break;
-      case 'n': out += '\n'; break;
-      default: return false;
+      case '\\':
+        out += '\\';
+        break;
+      case '"':
+        out += '"';
+        break;
+      case 'n':
+        out += '\n';
+        break;
+      default:
+        return false;
     }
   }
   return true;
 }
 
 struct Parsed {
-  std::map<std::string, std::string> types;              // family → counter/gauge
+  std::map<std::string, std::string> types;                // family → counter/gauge
   std::vector<std::map<std::string, std::string>> labels;  // per sample, unescaped
   std::vector<std::string> errors;
 };
@@ -206,7 +213,7 @@ Parsed parse_exposition(const std::string& text) {
       R"(([a-zA-Z_:][a-zA-Z0-9_:]*)(\{(.*)\})? (NaN|[+-]Inf|[+-]?[0-9]+(\.[0-9]+)?([eE][+-]?[0-9]+)?))");
   static const std::regex label(R"(([a-zA-Z_][a-zA-Z0-9_]*)="((?:[^"\\]|\\.)*)\"(,|$))");
   Parsed p;
-  std::string current;             // family being read
+  std::string current;  // family being read
   bool help_seen = false;
   std::istringstream lines(text);
   std::string line;
@@ -227,9 +234,9 @@ Parsed parse_exposition(const std::string& text) {
       help_seen = false;
     } else if (std::regex_match(line, m, sample)) {
       const std::string name = m[1];
-      const bool histogram_part = p.types.count(current) && p.types[current] == "histogram" &&
-                                  (name == current + "_bucket" || name == current + "_sum" ||
-                                   name == current + "_count");
+      const bool histogram_part =
+          p.types.count(current) && p.types[current] == "histogram" &&
+          (name == current + "_bucket" || name == current + "_sum" || name == current + "_count");
       if ((name != current && !histogram_part) || !p.types.count(current))
         p.errors.push_back(at + "sample of " + name + " outside its family");
       if (p.types.count(current) && p.types[current] == "histogram" && !histogram_part)
@@ -260,15 +267,15 @@ Parsed parse_exposition(const std::string& text) {
 // The checker itself must be able to fail, or the test above proves nothing.
 TEST(PrometheusText, GrammarCheckRejectsBrokenExpositions) {
   const char* broken[] = {
-      "x 1",                                                    // no final line feed
-      "x 1\n",                                                 // sample without metadata
-      "# HELP x h\n# TYPE x gauge\nx{a=\"1\"\",b=\"2\"} 1\n",  // stray quote
-      "# HELP x h\n# TYPE x gauge\nx{a=\"\\q\"} 1\n",          // unknown escape
+      "x 1",                                                                      // no final line feed
+      "x 1\n",                                                                    // sample without metadata
+      "# HELP x h\n# TYPE x gauge\nx{a=\"1\"\",b=\"2\"} 1\n",                     // stray quote
+      "# HELP x h\n# TYPE x gauge\nx{a=\"\\q\"} 1\n",                             // unknown escape
       "# HELP x h\n# TYPE x gauge\nx 1\n# HELP y h\n# TYPE y gauge\ny 1\nx 2\n",  // split family
-      "# HELP x h\n# TYPE x gauge\nx 1\n# HELP x h\n# TYPE x gauge\n",          // repeated family
-      "# HELP x h\n# TYPE x counter\nx 1\n",                  // counter without _total
-      "# HELP x h\n# TYPE x gauge\nx one\n",                  // not a number
-      "# HELP x h\n# TYPE x histogram\nx_total 1\n",          // not a histogram's sample
+      "# HELP x h\n# TYPE x gauge\nx 1\n# HELP x h\n# TYPE x gauge\n",            // repeated family
+      "# HELP x h\n# TYPE x counter\nx 1\n",                                      // counter without _total
+      "# HELP x h\n# TYPE x gauge\nx one\n",                                      // not a number
+      "# HELP x h\n# TYPE x histogram\nx_total 1\n",                              // not a histogram's sample
   };
   for (const char* text : broken) EXPECT_FALSE(parse_exposition(text).errors.empty()) << text;
   EXPECT_TRUE(parse_exposition("# HELP x h\n# TYPE x gauge\nx{a=\"\\\"\\n\"} -1.5e3\n").errors.empty());
@@ -280,7 +287,7 @@ TEST(PrometheusText, OutputFollowsTheTextFormatGrammar) {
   third.stream = "back\\\\slash\"\n\n";
   third.state = "finished";
   third.inference.add(std::numeric_limits<double>::infinity());  // not counted
-  third.inference.add(1e9);                                     // counted under +Inf
+  third.inference.add(1e9);                                      // counted under +Inf
   third.frames_in = std::numeric_limits<std::uint64_t>::max();
   third.sinks = {{"odd \"sink\"", "shm", true, 7, 672, 2}};
   snapshot.push_back(third);

@@ -45,8 +45,7 @@ class FloGroundTruth : public ::testing::TestWithParam<GroundTruth> {};
 
 double valid_share(const FlowField& f) {
   if (!f.has_mask()) return 1.0;
-  return static_cast<double>(std::count(f.valid.begin(), f.valid.end(), 1)) /
-         static_cast<double>(f.pixel_count());
+  return static_cast<double>(std::count(f.valid.begin(), f.valid.end(), 1)) / static_cast<double>(f.pixel_count());
 }
 
 TEST_P(FlowGroundTruth, ReadsWithTheDocumentedSize) {
@@ -63,8 +62,8 @@ TEST_P(FlowGroundTruth, ReadsWithTheDocumentedSize) {
   for (std::size_t i = 0; i < f.pixel_count(); ++i) {
     ASSERT_TRUE(std::isfinite(f.uv[2 * i]) && std::isfinite(f.uv[2 * i + 1]));
     if (!f.has_mask() || f.valid[i]) {
-      max_magnitude = std::max(max_magnitude, std::hypot(static_cast<double>(f.uv[2 * i]),
-                                                         static_cast<double>(f.uv[2 * i + 1])));
+      max_magnitude =
+          std::max(max_magnitude, std::hypot(static_cast<double>(f.uv[2 * i]), static_cast<double>(f.uv[2 * i + 1])));
     }
   }
   EXPECT_GT(max_magnitude, 0.5);
@@ -134,8 +133,7 @@ std::string fixture_name(const ::testing::TestParamInfo<GroundTruth>& info) {
 INSTANTIATE_TEST_SUITE_P(FlowGt, FlowGroundTruth, ::testing::ValuesIn(kGroundTruth), fixture_name);
 // OpenCV's reader speaks only .flo: every entry but the KITTI PNG, which is last.
 INSTANTIATE_TEST_SUITE_P(FlowGt, FloGroundTruth,
-                         ::testing::ValuesIn(std::begin(kGroundTruth), std::end(kGroundTruth) - 1),
-                         fixture_name);
+                         ::testing::ValuesIn(std::begin(kGroundTruth), std::end(kGroundTruth) - 1), fixture_name);
 
 }  // namespace
 }  // namespace neuflow::flow

@@ -160,15 +160,13 @@ TEST(FloFormat, WeReadWhatOpenCvWrites) {
 
 TEST(FloFormatErrors, MissingFile) {
   test::TempDir dir;
-  expect_flow_error([&] { read_flo(dir / "none.flo"); }, Kind::not_found, dir / "none.flo",
-                    "no such file");
+  expect_flow_error([&] { read_flo(dir / "none.flo"); }, Kind::not_found, dir / "none.flo", "no such file");
 }
 
 TEST(FloFormatErrors, DirectoryIsNotAFile) {
   test::TempDir dir;
   std::filesystem::create_directory(dir / "d.flo");
-  expect_flow_error([&] { read_flo(dir / "d.flo"); }, Kind::not_found, dir / "d.flo",
-                    "directory");
+  expect_flow_error([&] { read_flo(dir / "d.flo"); }, Kind::not_found, dir / "d.flo", "directory");
 }
 
 TEST(FloFormatErrors, WrongMagic) {
@@ -178,22 +176,19 @@ TEST(FloFormatErrors, WrongMagic) {
   append_f32(b, 0.f);
   append_f32(b, 0.f);
   test::write_bytes(dir / "bad.flo", b);
-  expect_flow_error([&] { read_flo(dir / "bad.flo"); }, Kind::malformed, dir / "bad.flo",
-                    "wrong magic");
+  expect_flow_error([&] { read_flo(dir / "bad.flo"); }, Kind::malformed, dir / "bad.flo", "wrong magic");
 }
 
 TEST(FloFormatErrors, TruncatedHeader) {
   test::TempDir dir;
   test::write_bytes(dir / "t.flo", {'P', 'I', 'E', 'H', 1});
-  expect_flow_error([&] { read_flo(dir / "t.flo"); }, Kind::malformed, dir / "t.flo",
-                    "truncated");
+  expect_flow_error([&] { read_flo(dir / "t.flo"); }, Kind::malformed, dir / "t.flo", "truncated");
 }
 
 TEST(FloFormatErrors, EmptyFile) {
   test::TempDir dir;
   test::write_bytes(dir / "e.flo", {});
-  expect_flow_error([&] { read_flo(dir / "e.flo"); }, Kind::malformed, dir / "e.flo",
-                    "truncated");
+  expect_flow_error([&] { read_flo(dir / "e.flo"); }, Kind::malformed, dir / "e.flo", "truncated");
 }
 
 TEST(FloFormatErrors, TruncatedData) {
@@ -201,8 +196,7 @@ TEST(FloFormatErrors, TruncatedData) {
   auto b = flo_header(4, 4);
   for (int i = 0; i < 31; ++i) append_f32(b, 1.f);  // one float short
   test::write_bytes(dir / "t.flo", b);
-  expect_flow_error([&] { read_flo(dir / "t.flo"); }, Kind::malformed, dir / "t.flo",
-                    "truncated: the header says 4x4");
+  expect_flow_error([&] { read_flo(dir / "t.flo"); }, Kind::malformed, dir / "t.flo", "truncated: the header says 4x4");
 }
 
 TEST(FloFormatErrors, TrailingDataMeansSizeMismatch) {
@@ -210,8 +204,7 @@ TEST(FloFormatErrors, TrailingDataMeansSizeMismatch) {
   auto b = flo_header(2, 2);
   for (int i = 0; i < 10; ++i) append_f32(b, 1.f);
   test::write_bytes(dir / "t.flo", b);
-  expect_flow_error([&] { read_flo(dir / "t.flo"); }, Kind::malformed, dir / "t.flo",
-                    "trailing data");
+  expect_flow_error([&] { read_flo(dir / "t.flo"); }, Kind::malformed, dir / "t.flo", "trailing data");
 }
 
 TEST(FloFormatErrors, AbsurdDimensionsAreRefusedBeforeAllocating) {
@@ -220,13 +213,11 @@ TEST(FloFormatErrors, AbsurdDimensionsAreRefusedBeforeAllocating) {
       {0, 5}, {5, 0}, {-1, 5}, {40000, 1}, {1, 40000}, {30000, 30000}, {-2147483647 - 1, -1}};
   for (const auto& [w, h] : sizes) {
     test::write_bytes(dir / "big.flo", flo_header(w, h));
-    expect_flow_error([&] { read_flo(dir / "big.flo"); }, Kind::malformed, dir / "big.flo",
-                      "implausible size");
+    expect_flow_error([&] { read_flo(dir / "big.flo"); }, Kind::malformed, dir / "big.flo", "implausible size");
   }
   // The largest accepted size in a 12-byte file: caught by the size check, not by new[].
   test::write_bytes(dir / "big.flo", flo_header(16384, 16384));
-  expect_flow_error([&] { read_flo(dir / "big.flo"); }, Kind::malformed, dir / "big.flo",
-                    "truncated");
+  expect_flow_error([&] { read_flo(dir / "big.flo"); }, Kind::malformed, dir / "big.flo", "truncated");
 }
 
 TEST(FloFormatErrors, InconsistentFieldIsRejectedOnWrite) {

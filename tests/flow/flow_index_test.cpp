@@ -25,11 +25,8 @@ TEST(FlowIndex, RowWritesUnknownTimestampsAndSourcesAsEmptyFields) {
 
 TEST(FlowIndex, TextFieldsAreQuotedOnlyWhenTheyNeedIt) {
   const std::pair<std::string_view, std::string_view> cases[] = {
-      {"plain name.flo", "plain name.flo"},
-      {"x,y.flo", "\"x,y.flo\""},
-      {"say \"hi\"", "\"say \"\"hi\"\"\""},
-      {"line\nbreak", "\"line\nbreak\""},
-      {"cr\r", "\"cr\r\""},
+      {"plain name.flo", "plain name.flo"}, {"x,y.flo", "\"x,y.flo\""}, {"say \"hi\"", "\"say \"\"hi\"\"\""},
+      {"line\nbreak", "\"line\nbreak\""},   {"cr\r", "\"cr\r\""},
   };
   for (const auto& [text, field] : cases) EXPECT_EQ(csv_field(text), field) << text;
   EXPECT_EQ(flow_index_row({1, 1, 2, 10, 20, "a,b.flo", "c\"d.png", "e.png"}),

@@ -74,20 +74,17 @@ TEST(FlowIo, UnknownExtension) {
   test::write_bytes(dir / "a.jpg", {1, 2, 3});
   expect_flow_error([&] { read_flow(dir / "a.jpg"); }, Kind::unsupported_format, dir / "a.jpg",
                     "unknown flow file extension '.jpg' (expected .flo, .png or .npy)");
-  expect_flow_error([&] { write_flow(FlowField(2, 2), dir / "b.txt"); }, Kind::unsupported_format,
-                    dir / "b.txt", "unknown flow file extension");
+  expect_flow_error([&] { write_flow(FlowField(2, 2), dir / "b.txt"); }, Kind::unsupported_format, dir / "b.txt",
+                    "unknown flow file extension");
   test::write_bytes(dir / "noext", {1});
-  expect_flow_error([&] { read_flow(dir / "noext"); }, Kind::unsupported_format, dir / "noext",
-                    "no file extension");
+  expect_flow_error([&] { read_flow(dir / "noext"); }, Kind::unsupported_format, dir / "noext", "no file extension");
   EXPECT_FALSE(std::filesystem::exists(dir / "b.txt"));
 }
 
 TEST(FlowIo, MissingFileWinsOverUnknownExtension) {
   test::TempDir dir;
-  expect_flow_error([&] { read_flow(dir / "typo.fl"); }, Kind::not_found, dir / "typo.fl",
-                    "no such file");
-  expect_flow_error([&] { read_flow(dir / "none.flo"); }, Kind::not_found, dir / "none.flo",
-                    "no such file");
+  expect_flow_error([&] { read_flow(dir / "typo.fl"); }, Kind::not_found, dir / "typo.fl", "no such file");
+  expect_flow_error([&] { read_flow(dir / "none.flo"); }, Kind::not_found, dir / "none.flo", "no such file");
 }
 
 TEST(FlowIo, WriteReplacesAnExistingFileAndLeavesNoTemporary) {
@@ -104,13 +101,13 @@ TEST(FlowIo, FailedWriteThrowsAndLeavesNoTemporary) {
   test::TempDir dir;
   // rename() cannot replace a directory: the data is written, the final step fails.
   std::filesystem::create_directory(dir / "taken.flo");
-  expect_flow_error([&] { write_flow(test::make_field(4, 4), dir / "taken.flo"); },
-                    Kind::write_failed, dir / "taken.flo", "cannot replace");
+  expect_flow_error([&] { write_flow(test::make_field(4, 4), dir / "taken.flo"); }, Kind::write_failed,
+                    dir / "taken.flo", "cannot replace");
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"taken.flo"}));
   EXPECT_TRUE(std::filesystem::is_directory(dir / "taken.flo"));
 
-  expect_flow_error([&] { write_flow(test::make_field(4, 4), dir / "no" / "such" / "dir.npy"); },
-                    Kind::write_failed, dir / "no" / "such" / "dir.npy", "cannot create");
+  expect_flow_error([&] { write_flow(test::make_field(4, 4), dir / "no" / "such" / "dir.npy"); }, Kind::write_failed,
+                    dir / "no" / "such" / "dir.npy", "cannot create");
   EXPECT_EQ(dir.entries(), (std::vector<std::string>{"taken.flo"}));
 }
 
@@ -118,10 +115,9 @@ TEST(FlowIo, ReadOnlyDirectory) {
   if (::geteuid() == 0) GTEST_SKIP() << "running as root: permissions do not stop writes";
   test::TempDir dir;
   std::filesystem::create_directory(dir / "ro");
-  std::filesystem::permissions(dir / "ro", std::filesystem::perms::owner_read |
-                                               std::filesystem::perms::owner_exec);
-  expect_flow_error([&] { write_flow(test::make_field(4, 4), dir / "ro" / "x.png"); },
-                    Kind::write_failed, dir / "ro" / "x.png", "Permission denied");
+  std::filesystem::permissions(dir / "ro", std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec);
+  expect_flow_error([&] { write_flow(test::make_field(4, 4), dir / "ro" / "x.png"); }, Kind::write_failed,
+                    dir / "ro" / "x.png", "Permission denied");
   std::filesystem::permissions(dir / "ro", std::filesystem::perms::owner_all);
   EXPECT_TRUE(std::filesystem::is_empty(dir / "ro"));
 }

@@ -136,15 +136,13 @@ TEST(KittiPngErrors, WrongChannelCount) {
                     "must be RGB (3 channels), this one is grayscale");
   cv::Mat rgba(4, 4, CV_16UC4, cv::Scalar(5, 5, 5, 5));
   ASSERT_TRUE(cv::imwrite((dir / "a.png").string(), rgba));
-  expect_flow_error([&] { read_kitti_png(dir / "a.png"); }, Kind::malformed, dir / "a.png",
-                    "this one is RGBA");
+  expect_flow_error([&] { read_kitti_png(dir / "a.png"); }, Kind::malformed, dir / "a.png", "this one is RGBA");
 }
 
 TEST(KittiPngErrors, NotAPng) {
   test::TempDir dir;
   test::write_bytes(dir / "x.png", {'P', 'I', 'E', 'H', 0, 0, 0, 0, 0, 0, 0, 0});
-  expect_flow_error([&] { read_kitti_png(dir / "x.png"); }, Kind::malformed, dir / "x.png",
-                    "not a PNG");
+  expect_flow_error([&] { read_kitti_png(dir / "x.png"); }, Kind::malformed, dir / "x.png", "not a PNG");
 }
 
 TEST(KittiPngErrors, TruncatedPng) {
@@ -153,12 +151,10 @@ TEST(KittiPngErrors, TruncatedPng) {
   auto bytes = test::read_bytes(dir / "k.png");
   bytes.resize(bytes.size() / 2);
   test::write_bytes(dir / "half.png", bytes);
-  expect_flow_error([&] { read_kitti_png(dir / "half.png"); }, Kind::malformed,
-                    dir / "half.png", "decode");
+  expect_flow_error([&] { read_kitti_png(dir / "half.png"); }, Kind::malformed, dir / "half.png", "decode");
   bytes.resize(20);
   test::write_bytes(dir / "head.png", bytes);
-  expect_flow_error([&] { read_kitti_png(dir / "head.png"); }, Kind::malformed,
-                    dir / "head.png", "IHDR");
+  expect_flow_error([&] { read_kitti_png(dir / "head.png"); }, Kind::malformed, dir / "head.png", "IHDR");
 }
 
 TEST(KittiPngErrors, AbsurdSizeInTheHeader) {
@@ -171,14 +167,13 @@ TEST(KittiPngErrors, AbsurdSizeInTheHeader) {
   bytes[18] = 0x86;
   bytes[19] = 0xa0;
   test::write_bytes(dir / "wide.png", bytes);
-  expect_flow_error([&] { read_kitti_png(dir / "wide.png"); }, Kind::malformed,
-                    dir / "wide.png", "implausible PNG size 100000x4");
+  expect_flow_error([&] { read_kitti_png(dir / "wide.png"); }, Kind::malformed, dir / "wide.png",
+                    "implausible PNG size 100000x4");
 }
 
 TEST(KittiPngErrors, MissingFile) {
   test::TempDir dir;
-  expect_flow_error([&] { read_kitti_png(dir / "none.png"); }, Kind::not_found,
-                    dir / "none.png", "no such file");
+  expect_flow_error([&] { read_kitti_png(dir / "none.png"); }, Kind::not_found, dir / "none.png", "no such file");
 }
 
 }  // namespace

@@ -113,9 +113,7 @@ TEST(Metrics, SizeMismatchIsAClearError) {
     compute_metrics(FlowField(4, 3), FlowField(3, 4));
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("prediction is 4x3 but ground truth is 3x4"),
-              std::string::npos)
-        << e.what();
+    EXPECT_NE(std::string(e.what()).find("prediction is 4x3 but ground truth is 3x4"), std::string::npos) << e.what();
   }
   FlowField broken(2, 2);
   broken.uv.pop_back();
@@ -124,7 +122,7 @@ TEST(Metrics, SizeMismatchIsAClearError) {
 
 // Pooled counts give the measures of the pixels together: the same as one field holding both.
 TEST(Metrics, PooledCountsEqualTheMetricsOfTheFieldsTogether) {
-  const FlowField gt_a = constant(4, 2, 1.f, 0.f), pred_a = constant(4, 2, 4.f, 4.f);  // error 5
+  const FlowField gt_a = constant(4, 2, 1.f, 0.f), pred_a = constant(4, 2, 4.f, 4.f);   // error 5
   const FlowField gt_b = constant(2, 2, 0.f, 0.f), pred_b = constant(2, 2, 0.5f, 0.f);  // error 0.5
   MetricCounts pooled = compute_metrics(pred_a, gt_a).counts;
   pooled += compute_metrics(pred_b, gt_b).counts;

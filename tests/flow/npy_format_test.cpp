@@ -53,9 +53,7 @@ TEST(NpyFormat, HeaderIsWhatNumpyWrites) {
   const std::size_t header_len = b[8] | (b[9] << 8);
   EXPECT_EQ((10 + header_len) % 64, 0u) << "data must start 64-byte aligned";
   const std::string header(b.begin() + 10, b.begin() + 10 + static_cast<std::ptrdiff_t>(header_len));
-  EXPECT_EQ(header.rfind("{'descr': '<f4', 'fortran_order': False, 'shape': (436, 1024, 2), }", 0),
-            0u)
-      << header;
+  EXPECT_EQ(header.rfind("{'descr': '<f4', 'fortran_order': False, 'shape': (436, 1024, 2), }", 0), 0u) << header;
   EXPECT_EQ(header.back(), '\n');
   EXPECT_EQ(b.size(), 10 + header_len + 8u * 1024 * 436);
 }
@@ -87,8 +85,7 @@ TEST(NpyFormat, MaskRoundTripsThroughNaN) {
 TEST(NpyFormat, ReadsVersion2AndOddButValidHeaders) {
   test::TempDir dir;
   // Version 2.0 (4-byte header length), double quotes, no trailing comma, Python 2 longs.
-  auto b = npy_bytes("{\"descr\": \"<f4\", \"shape\": (2L, 3L, 2L), \"fortran_order\": False}",
-                     2 * 3 * 8, /*major=*/2);
+  auto b = npy_bytes("{\"descr\": \"<f4\", \"shape\": (2L, 3L, 2L), \"fortran_order\": False}", 2 * 3 * 8, /*major=*/2);
   const std::size_t data = b.size() - 2 * 3 * 8;
   for (int i = 0; i < 12; ++i) {
     const float x = static_cast<float>(i) * 0.5f;
@@ -107,20 +104,16 @@ TEST(NpyFormatErrors, WrongMagic) {
   auto b = npy_bytes(f4_dict("(1, 1, 2)"), 8);
   b[1] = 'X';
   test::write_bytes(dir / "a.npy", b);
-  expect_flow_error([&] { read_npy(dir / "a.npy"); }, Kind::malformed, dir / "a.npy",
-                    "wrong magic");
+  expect_flow_error([&] { read_npy(dir / "a.npy"); }, Kind::malformed, dir / "a.npy", "wrong magic");
 }
 
 TEST(NpyFormatErrors, WrongDtype) {
   test::TempDir dir;
-  test::write_bytes(dir / "d.npy",
-                    npy_bytes("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2, 2), }", 64));
+  test::write_bytes(dir / "d.npy", npy_bytes("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2, 2), }", 64));
   expect_flow_error([&] { read_npy(dir / "d.npy"); }, Kind::malformed, dir / "d.npy",
                     "dtype '<f8' (float64) is not supported");
-  test::write_bytes(dir / "b.npy",
-                    npy_bytes("{'descr': '>f4', 'fortran_order': False, 'shape': (2, 2, 2), }", 32));
-  expect_flow_error([&] { read_npy(dir / "b.npy"); }, Kind::malformed, dir / "b.npy",
-                    "big-endian float32");
+  test::write_bytes(dir / "b.npy", npy_bytes("{'descr': '>f4', 'fortran_order': False, 'shape': (2, 2, 2), }", 32));
+  expect_flow_error([&] { read_npy(dir / "b.npy"); }, Kind::malformed, dir / "b.npy", "big-endian float32");
 }
 
 TEST(NpyFormatErrors, WrongShape) {
@@ -135,10 +128,8 @@ TEST(NpyFormatErrors, WrongShape) {
 
 TEST(NpyFormatErrors, FortranOrder) {
   test::TempDir dir;
-  test::write_bytes(dir / "f.npy",
-                    npy_bytes("{'descr': '<f4', 'fortran_order': True, 'shape': (2, 2, 2), }", 32));
-  expect_flow_error([&] { read_npy(dir / "f.npy"); }, Kind::malformed, dir / "f.npy",
-                    "Fortran-order");
+  test::write_bytes(dir / "f.npy", npy_bytes("{'descr': '<f4', 'fortran_order': True, 'shape': (2, 2, 2), }", 32));
+  expect_flow_error([&] { read_npy(dir / "f.npy"); }, Kind::malformed, dir / "f.npy", "Fortran-order");
 }
 
 TEST(NpyFormatErrors, TruncatedAndTrailingData) {
@@ -147,27 +138,21 @@ TEST(NpyFormatErrors, TruncatedAndTrailingData) {
   expect_flow_error([&] { read_npy(dir / "t.npy"); }, Kind::malformed, dir / "t.npy",
                     "truncated: shape (3, 3, 2) needs");
   test::write_bytes(dir / "l.npy", npy_bytes(f4_dict("(3, 3, 2)"), 73));
-  expect_flow_error([&] { read_npy(dir / "l.npy"); }, Kind::malformed, dir / "l.npy",
-                    "trailing data");
+  expect_flow_error([&] { read_npy(dir / "l.npy"); }, Kind::malformed, dir / "l.npy", "trailing data");
   test::write_bytes(dir / "h.npy", {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0x80, 0});
-  expect_flow_error([&] { read_npy(dir / "h.npy"); }, Kind::malformed, dir / "h.npy",
-                    "header length");
+  expect_flow_error([&] { read_npy(dir / "h.npy"); }, Kind::malformed, dir / "h.npy", "header length");
   test::write_bytes(dir / "s.npy", {0x93, 'N', 'U'});
-  expect_flow_error([&] { read_npy(dir / "s.npy"); }, Kind::malformed, dir / "s.npy",
-                    "truncated");
+  expect_flow_error([&] { read_npy(dir / "s.npy"); }, Kind::malformed, dir / "s.npy", "truncated");
 }
 
 TEST(NpyFormatErrors, AbsurdShapeIsRefusedBeforeAllocating) {
   test::TempDir dir;
   test::write_bytes(dir / "a.npy", npy_bytes(f4_dict("(100000, 100000, 2)"), 0));
-  expect_flow_error([&] { read_npy(dir / "a.npy"); }, Kind::malformed, dir / "a.npy",
-                    "implausible flow size");
+  expect_flow_error([&] { read_npy(dir / "a.npy"); }, Kind::malformed, dir / "a.npy", "implausible flow size");
   test::write_bytes(dir / "b.npy", npy_bytes(f4_dict("(99999999999999999999, 1, 2)"), 0));
-  expect_flow_error([&] { read_npy(dir / "b.npy"); }, Kind::malformed, dir / "b.npy",
-                    "too large");
+  expect_flow_error([&] { read_npy(dir / "b.npy"); }, Kind::malformed, dir / "b.npy", "too large");
   test::write_bytes(dir / "c.npy", npy_bytes(f4_dict("(16384, 16384, 2)"), 8));
-  expect_flow_error([&] { read_npy(dir / "c.npy"); }, Kind::malformed, dir / "c.npy",
-                    "truncated");
+  expect_flow_error([&] { read_npy(dir / "c.npy"); }, Kind::malformed, dir / "c.npy", "truncated");
 }
 
 TEST(NpyFormatErrors, UnsupportedVersionAndBrokenHeader) {
@@ -175,14 +160,11 @@ TEST(NpyFormatErrors, UnsupportedVersionAndBrokenHeader) {
   auto b = npy_bytes(f4_dict("(1, 1, 2)"), 8);
   b[6] = 9;
   test::write_bytes(dir / "v.npy", b);
-  expect_flow_error([&] { read_npy(dir / "v.npy"); }, Kind::malformed, dir / "v.npy",
-                    "version 9.0");
+  expect_flow_error([&] { read_npy(dir / "v.npy"); }, Kind::malformed, dir / "v.npy", "version 9.0");
   test::write_bytes(dir / "p.npy", npy_bytes("{'descr': '<f4', 'shape': [1, 1, 2]", 8));
-  expect_flow_error([&] { read_npy(dir / "p.npy"); }, Kind::malformed, dir / "p.npy",
-                    "cannot parse the .npy header");
+  expect_flow_error([&] { read_npy(dir / "p.npy"); }, Kind::malformed, dir / "p.npy", "cannot parse the .npy header");
   test::write_bytes(dir / "k.npy", npy_bytes("{'descr': '<f4', 'shape': (1, 1, 2)}", 8));
-  expect_flow_error([&] { read_npy(dir / "k.npy"); }, Kind::malformed, dir / "k.npy",
-                    "exactly the keys");
+  expect_flow_error([&] { read_npy(dir / "k.npy"); }, Kind::malformed, dir / "k.npy", "exactly the keys");
 }
 
 // --- Interoperability with numpy itself -------------------------------------------------
@@ -268,12 +250,9 @@ np.save(os.path.join(d, 'fortran.npy'), np.asfortranarray(a))
     EXPECT_FALSE(g.is_valid(3, 2));
     EXPECT_EQ(std::count(g.valid.begin(), g.valid.end(), 0), 1);
   }
-  expect_flow_error([&] { read_npy(dir_ / "f8.npy"); }, Kind::malformed, dir_ / "f8.npy",
-                    "float64");
-  expect_flow_error([&] { read_npy(dir_ / "chw.npy"); }, Kind::malformed, dir_ / "chw.npy",
-                    "array shape (2, 5, 7)");
-  expect_flow_error([&] { read_npy(dir_ / "fortran.npy"); }, Kind::malformed,
-                    dir_ / "fortran.npy", "Fortran-order");
+  expect_flow_error([&] { read_npy(dir_ / "f8.npy"); }, Kind::malformed, dir_ / "f8.npy", "float64");
+  expect_flow_error([&] { read_npy(dir_ / "chw.npy"); }, Kind::malformed, dir_ / "chw.npy", "array shape (2, 5, 7)");
+  expect_flow_error([&] { read_npy(dir_ / "fortran.npy"); }, Kind::malformed, dir_ / "fortran.npy", "Fortran-order");
 }
 
 TEST(NpyArray, ReadsAnyRankAndChecksTheShapeBeforeTheData) {

@@ -16,8 +16,8 @@ namespace neuflow::flow {
 namespace {
 
 Rgb8 pixel(const RgbImage& img, int x, int y) {
-  const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) +
-                             static_cast<std::size_t>(x));
+  const std::size_t i =
+      3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x));
   return {img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
 }
 
@@ -42,10 +42,10 @@ TEST(ColorWheel, MatchesTheMiddleburyTable) {
 }
 
 TEST(ColorWheel, DirectionsGetTheirUsualColours) {
-  EXPECT_EQ(flow_color(1, 0), (Rgb8{255, 0, 0}));    // right: red (wheel index 0)
-  EXPECT_EQ(flow_color(0, 1), (Rgb8{255, 229, 0}));  // down: yellow-orange, between 13 and 14
+  EXPECT_EQ(flow_color(1, 0), (Rgb8{255, 0, 0}));     // right: red (wheel index 0)
+  EXPECT_EQ(flow_color(0, 1), (Rgb8{255, 229, 0}));   // down: yellow-orange, between 13 and 14
   EXPECT_EQ(flow_color(-1, 0), (Rgb8{0, 209, 255}));  // left: cyan-blue, index 27
-  EXPECT_EQ(flow_color(0, -1), (Rgb8{88, 0, 255}));  // up: blue-violet, between 40 and 41
+  EXPECT_EQ(flow_color(0, -1), (Rgb8{88, 0, 255}));   // up: blue-violet, between 40 and 41
 }
 
 TEST(ColorWheel, SaturationGrowsWithMagnitudeAndOutOfRangeIsDimmed) {
@@ -101,9 +101,9 @@ TEST(Visualize, InvalidAndNonFinitePixelsAreBlackAndIgnoredForTheMaximum) {
 
 TEST(Visualize, FixedMaximum) {
   FlowField f(3, 1);
-  f.u(0, 0) = 5.f;    // at the maximum: full red
-  f.u(1, 0) = 10.f;   // beyond: dimmed red
-  f.u(2, 0) = 2.5f;   // half
+  f.u(0, 0) = 5.f;   // at the maximum: full red
+  f.u(1, 0) = 10.f;  // beyond: dimmed red
+  f.u(2, 0) = 2.5f;  // half
   VisualizeOptions options;
   options.max_flow = 5.0;
   const Visualization v = visualize_flow(f, options);
@@ -122,8 +122,8 @@ TEST(Visualize, MatchesFlowColorOfTheNormalizedVector) {
   const Visualization v = visualize_flow(f);
   for (int y = 0; y < 12; y += 3) {
     for (int x = 0; x < 16; x += 5) {
-      const Rgb8 expected = flow_color(static_cast<double>(f.u(x, y)) / v.max_flow,
-                                       static_cast<double>(f.v(x, y)) / v.max_flow);
+      const Rgb8 expected =
+          flow_color(static_cast<double>(f.u(x, y)) / v.max_flow, static_cast<double>(f.v(x, y)) / v.max_flow);
       const Rgb8 got = pixel(v.image, x, y);
       for (std::size_t c = 0; c < 3; ++c) EXPECT_NEAR(got[c], expected[c], 1) << x << "," << y;
     }

@@ -13,11 +13,11 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static neuflow::fuzz::InputFile file("fuzz-input-pickle.pth");
-  const std::string zip = neuflow::fuzz::checkpoint_around_pickle(
-      std::string(reinterpret_cast<const char*>(data), size));
+  const std::string zip =
+      neuflow::fuzz::checkpoint_around_pickle(std::string(reinterpret_cast<const char*>(data), size));
   try {
-    const auto checkpoint = neuflow::model::load_checkpoint(
-        file.write(reinterpret_cast<const std::uint8_t*>(zip.data()), zip.size()));
+    const auto checkpoint =
+        neuflow::model::load_checkpoint(file.write(reinterpret_cast<const std::uint8_t*>(zip.data()), zip.size()));
     neuflow::fuzz::check_checkpoint("checkpoint_pickle", checkpoint);
   } catch (const neuflow::model::CheckpointError&) {
   } catch (...) {

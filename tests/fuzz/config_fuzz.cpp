@@ -13,8 +13,8 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    const auto config = neuflow::daemon::parse_config(text, "/fuzz/neuflowd.toml",
-                                                      neuflow::daemon::ConfigChecks::file_only);
+    const auto config =
+        neuflow::daemon::parse_config(text, "/fuzz/neuflowd.toml", neuflow::daemon::ConfigChecks::file_only);
     if (config.streams.empty()) neuflow::fuzz::invariant_failed("config", "accepted without a stream");
     for (const auto& stream : config.streams) {
       if (stream.sinks.empty()) {
@@ -25,7 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const neuflow::daemon::ConfigError& error) {
     bool has_error = false;
     for (const auto& issue : error.issues()) has_error = has_error || !issue.is_warning();
-    if (!has_error) neuflow::fuzz::invariant_failed("config", "ConfigError without an error: " + std::string(error.what()));
+    if (!has_error)
+      neuflow::fuzz::invariant_failed("config", "ConfigError without an error: " + std::string(error.what()));
   } catch (...) {
     neuflow::fuzz::unexpected_exception("config");
   }

@@ -12,9 +12,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static neuflow::fuzz::InputFile file("fuzz-input.flo");
   try {
     const auto field = neuflow::flow::read_flo(file.write(data, size));
-    neuflow::fuzz::check_flow_field("flo", field,
-                                    {.never_all_valid_mask = true,
-                                     .max_magnitude = neuflow::flow::kFloUnknownThreshold});
+    neuflow::fuzz::check_flow_field(
+        "flo", field, {.never_all_valid_mask = true, .max_magnitude = neuflow::flow::kFloUnknownThreshold});
   } catch (const neuflow::flow::FlowFileError&) {
   } catch (...) {
     neuflow::fuzz::unexpected_exception("flo");

@@ -3,8 +3,8 @@
 // headers): a size within limits.hpp, consistent buffers, finite values, and the zero
 // placeholder for invalid pixels.
 #include <cmath>
-#include <limits>
 #include <cstddef>
+#include <limits>
 #include <string>
 
 #include "fuzz_support.hpp"
@@ -14,9 +14,9 @@
 namespace neuflow::fuzz {
 
 struct FlowPromises {
-  bool always_masked = false;  // KITTI: the mask is always there
+  bool always_masked = false;         // KITTI: the mask is always there
   bool never_all_valid_mask = false;  // .flo/.npy: the mask is left empty when every pixel is valid
-  float max_magnitude = std::numeric_limits<float>::infinity();   // of a valid u or v
+  float max_magnitude = std::numeric_limits<float>::infinity();  // of a valid u or v
 };
 
 inline void check_flow_field(const char* harness, const flow::FlowField& f, const FlowPromises& promises) {

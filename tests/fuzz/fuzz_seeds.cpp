@@ -81,8 +81,8 @@ std::string npy(int major, std::string header, std::size_t floats) {
 void write_flow_seeds(const fs::path& out) {
   int i = 0;
   for (const auto& field : sample_fields()) {
-    const std::string stem = "field-" + std::to_string(i++) + "-" + std::to_string(field.width) + "x" +
-                             std::to_string(field.height);
+    const std::string stem =
+        "field-" + std::to_string(i++) + "-" + std::to_string(field.width) + "x" + std::to_string(field.height);
     neuflow::flow::write_flo(field, seed_path(out, "flo", stem + ".flo"));
     neuflow::flow::write_npy(field, seed_path(out, "npy", stem + ".npy"));
     neuflow::flow::write_kitti_png(field, seed_path(out, "kitti_png", stem + ".png"));
@@ -138,18 +138,18 @@ std::vector<std::pair<std::string, FakeCheckpoint>> sample_checkpoints() {
        tensor("bn.running_mean", "FloatStorage", "0", 64, 26, {2}),
        tensor("bn.num_batches_tracked", "LongStorage", "1", 32, 0, {})});
   add("state-dict-dtypes", Wrapper::kStateDict,
-      {tensor("half", "HalfStorage", "2", 128, 0, {4, 4}),
-       tensor("bf16", "BFloat16Storage", "3", 128, 5, {8}),
+      {tensor("half", "HalfStorage", "2", 128, 0, {4, 4}), tensor("bf16", "BFloat16Storage", "3", 128, 5, {8}),
        tensor("transposed", "FloatStorage", "0", 64, 0, {3, 2}, {1, 3}),
        tensor("empty", "FloatStorage", "0", 64, 0, {0, 5})});
   add("bare-module-prefix", Wrapper::kBare,
-      {tensor("module.a", "DoubleStorage", "1", 32, 0, {2, 2}),
-       tensor("module.b", "IntStorage", "2", 64, 3, {5}),
+      {tensor("module.a", "DoubleStorage", "1", 32, 0, {2, 2}), tensor("module.b", "IntStorage", "2", 64, 3, {5}),
        tensor("module.c", "FloatStorage", "0", 64, 1, {2, 2, 2}, {16, 4, 1})});
   add("ordered-dict-metadata", Wrapper::kOrderedDictWithMetadata,
-      {tensor("backbone.w", "FloatStorage", "0", 64, 0, {4, 4}), tensor("backbone.b", "FloatStorage", "0", 64, 60, {4})});
+      {tensor("backbone.w", "FloatStorage", "0", 64, 0, {4, 4}),
+       tensor("backbone.b", "FloatStorage", "0", 64, 60, {4})});
   add("model-with-extras", Wrapper::kModelWithExtras,
-      {tensor("w", "FloatStorage", "3", 64, 0, {1, 1, 8, 8}), tensor("broadcast", "FloatStorage", "3", 64, 0, {4, 4}, {0, 1})});
+      {tensor("w", "FloatStorage", "3", 64, 0, {1, 1, 8, 8}),
+       tensor("broadcast", "FloatStorage", "3", 64, 0, {4, 4}, {0, 1})});
   return out;
 }
 
@@ -220,7 +220,8 @@ int check_seeds(const fs::path& out) {
     return name == "float64.npy" || name == "fortran.npy";
   };
   check("flo", [](const fs::path& p) { neuflow::flow::read_flo(p); });
-  check("npy", [](const fs::path& p) { neuflow::flow::read_npy_array(p); }, refused_by_design);
+  check(
+      "npy", [](const fs::path& p) { neuflow::flow::read_npy_array(p); }, refused_by_design);
   check("kitti_png", [](const fs::path& p) { neuflow::flow::read_kitti_png(p); });
   check("checkpoint", [](const fs::path& p) { neuflow::model::load_checkpoint(p); });
   check("checkpoint_pickle", [&](const fs::path& p) {
@@ -230,10 +231,13 @@ int check_seeds(const fs::path& out) {
   });
   fs::remove(out / "checkpoint_pickle.check.pth");
   // The shipped configs must load on the file alone; the regression inputs are refused.
-  check("config", [](const fs::path& p) {
-    neuflow::daemon::parse_config(neuflow::test::read_file(p), "/fuzz/" + p.filename().string(),
-                                  neuflow::daemon::ConfigChecks::file_only);
-  }, [](const fs::path& p) { return fs::exists(fs::path(NEUFLOW_FUZZ_REGRESSIONS_DIR) / "config" / p.filename()); });
+  check(
+      "config",
+      [](const fs::path& p) {
+        neuflow::daemon::parse_config(neuflow::test::read_file(p), "/fuzz/" + p.filename().string(),
+                                      neuflow::daemon::ConfigChecks::file_only);
+      },
+      [](const fs::path& p) { return fs::exists(fs::path(NEUFLOW_FUZZ_REGRESSIONS_DIR) / "config" / p.filename()); });
   return refused;
 }
 

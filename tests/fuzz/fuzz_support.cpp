@@ -67,14 +67,12 @@ void unexpected_exception(const char* harness) noexcept {
   } catch (...) {
     if (const std::type_info* info = abi::__cxa_current_exception_type()) type = demangled(info->name());
   }
-  std::fprintf(stderr, "\n==FUZZ== %s: undocumented exception %s: %s\n", harness, type.c_str(),
-               message.c_str());
+  std::fprintf(stderr, "\n==FUZZ== %s: undocumented exception %s: %s\n", harness, type.c_str(), message.c_str());
   std::abort();
 }
 
 void invariant_failed(const char* harness, const std::string& what) noexcept {
-  std::fprintf(stderr, "\n==FUZZ== %s: broken invariant of a successful result: %s\n", harness,
-               what.c_str());
+  std::fprintf(stderr, "\n==FUZZ== %s: broken invariant of a successful result: %s\n", harness, what.c_str());
   std::abort();
 }
 

@@ -13,8 +13,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static neuflow::fuzz::InputFile file("fuzz-input.png");
   try {
     const auto field = neuflow::flow::read_kitti_png(file.write(data, size));
-    neuflow::fuzz::check_flow_field("kitti_png", field,
-                                    {.always_masked = true, .max_magnitude = 512.f});
+    neuflow::fuzz::check_flow_field("kitti_png", field, {.always_masked = true, .max_magnitude = 512.f});
   } catch (const neuflow::flow::FlowFileError&) {
   } catch (...) {
     neuflow::fuzz::unexpected_exception("kitti_png");

@@ -29,10 +29,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     // The data size must match the file exactly (npy_format.hpp).
     if (count != array.data.size() || 4 * count > size) {
-      neuflow::fuzz::invariant_failed("npy (read_npy_array)",
-                                      std::to_string(array.data.size()) + " values for a shape of " +
-                                          std::to_string(count) + " elements in a file of " +
-                                          std::to_string(size) + " bytes");
+      neuflow::fuzz::invariant_failed("npy (read_npy_array)", std::to_string(array.data.size()) +
+                                                                  " values for a shape of " + std::to_string(count) +
+                                                                  " elements in a file of " + std::to_string(size) +
+                                                                  " bytes");
     }
   } catch (const neuflow::flow::FlowFileError&) {
   } catch (...) {

@@ -25,8 +25,7 @@ bool run_file(const std::filesystem::path& path) {
   // A buffer of its own for each input, exactly its size, so ASan sees reads past the end.
   std::vector<std::uint8_t> input(bytes.begin(), bytes.end());
   std::fprintf(stderr, "running %s (%zu bytes)\n", path.c_str(), input.size());
-  LLVMFuzzerTestOneInput(input.empty() ? reinterpret_cast<const std::uint8_t*>("") : input.data(),
-                         input.size());
+  LLVMFuzzerTestOneInput(input.empty() ? reinterpret_cast<const std::uint8_t*>("") : input.data(), input.size());
   return true;
 }
 

@@ -43,8 +43,8 @@ void neuflow_fuzz_toml_assert(const char* expression, const char* file, int line
       if (kKnown[i].line != line || !std::string_view(file).ends_with(kKnown[i].file)) continue;
       if (!reported[i]) {
         reported[i] = true;
-        std::fprintf(stderr, "==FUZZ== known toml++ assertion let through (reported once): %s:%d: %s\n",
-                     kKnown[i].file, line, kKnown[i].what);
+        std::fprintf(stderr, "==FUZZ== known toml++ assertion let through (reported once): %s:%d: %s\n", kKnown[i].file,
+                     line, kKnown[i].what);
       }
       return;
     }

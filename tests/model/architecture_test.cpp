@@ -24,9 +24,15 @@ TEST(Architecture, TableHasTheCheckpointsParameterCount) {
     EXPECT_TRUE(names.insert(spec.name).second) << "duplicate " << spec.name;
     EXPECT_EQ(model::classify_key(spec.name), spec.kind) << spec.name;
     switch (spec.kind) {
-      case ParameterKind::kParameter: parameters += spec.numel(); break;
-      case ParameterKind::kRunningStat: running += spec.numel(); break;
-      case ParameterKind::kBatchCounter: counters += spec.numel(); break;
+      case ParameterKind::kParameter:
+        parameters += spec.numel();
+        break;
+      case ParameterKind::kRunningStat:
+        running += spec.numel();
+        break;
+      case ParameterKind::kBatchCounter:
+        counters += spec.numel();
+        break;
     }
   }
   EXPECT_EQ(parameters, model::kNeuflowV2ParameterCount);
@@ -96,20 +102,18 @@ TEST(Architecture, WrongShapeIsNamed) {
 TEST(Architecture, UnexpectedKeyIsNamed) {
   TempDir dir;
   auto fake = fake_neuflow_checkpoint();
-  fake.tensors.push_back({.name = "flow_attn_s16.q.weight", .storage_key = "0",
-                          .storage_numel = 1179648, .size = {4, 4}});
+  fake.tensors.push_back(
+      {.name = "flow_attn_s16.q.weight", .storage_key = "0", .storage_numel = 1179648, .size = {4, 4}});
   fake.write(dir / "n.pth");
   const auto mismatch = model::find_architecture_mismatch(model::load_checkpoint(dir / "n.pth"));
   ASSERT_TRUE(mismatch.has_value());
-  EXPECT_NE(mismatch->find("unexpected tensor 'flow_attn_s16.q.weight' [4, 4]"), std::string::npos)
-      << *mismatch;
+  EXPECT_NE(mismatch->find("unexpected tensor 'flow_attn_s16.q.weight' [4, 4]"), std::string::npos) << *mismatch;
 }
 
 TEST(Architecture, BatchCountersAreOptionalAndModulePrefixIsStripped) {
   TempDir dir;
   auto fake = fake_neuflow_checkpoint();
-  std::erase_if(fake.tensors,
-                [](const FakeTensor& t) { return t.name.ends_with("num_batches_tracked"); });
+  std::erase_if(fake.tensors, [](const FakeTensor& t) { return t.name.ends_with("num_batches_tracked"); });
   for (auto& t : fake.tensors) t.name = "module." + t.name;
   fake.wrapper = Wrapper::kStateDict;
   fake.write(dir / "n.pth");

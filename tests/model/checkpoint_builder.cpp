@@ -200,8 +200,8 @@ void write_zip(const std::filesystem::path& path, const std::vector<ZipEntry>& e
       zip_source_free(source);
       throw std::runtime_error("zip_file_add failed for " + entry.name);
     }
-    zip_set_file_compression(archive, static_cast<zip_uint64_t>(index),
-                             entry.compress ? ZIP_CM_DEFLATE : ZIP_CM_STORE, 0);
+    zip_set_file_compression(archive, static_cast<zip_uint64_t>(index), entry.compress ? ZIP_CM_DEFLATE : ZIP_CM_STORE,
+                             0);
   }
   if (zip_close(archive) != 0) {
     const std::string message = zip_strerror(archive);

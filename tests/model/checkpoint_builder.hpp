@@ -43,8 +43,8 @@ class PickleWriter {
   PickleWriter& real(double v);                 // BINFLOAT
   PickleWriter& global(std::string_view module, std::string_view name);        // GLOBAL
   PickleWriter& stack_global(std::string_view module, std::string_view name);  // STACK_GLOBAL
-  PickleWriter& put(uint32_t index);  // BINPUT or LONG_BINPUT
-  PickleWriter& get(uint32_t index);  // BINGET or LONG_BINGET
+  PickleWriter& put(uint32_t index);                                           // BINPUT or LONG_BINPUT
+  PickleWriter& get(uint32_t index);                                           // BINGET or LONG_BINGET
 
   const std::string& bytes() const { return bytes_; }
 
@@ -70,8 +70,7 @@ void emit_tensor(PickleWriter& w, const FakeTensor& t);
 enum class Wrapper { kModel, kStateDict, kBare, kOrderedDictWithMetadata, kModelWithExtras };
 
 // The pickle of a state dict of `tensors`, wrapped as `wrapper`, protocol 2 as torch writes it.
-std::string state_dict_pickle(const std::vector<FakeTensor>& tensors,
-                              Wrapper wrapper = Wrapper::kModel);
+std::string state_dict_pickle(const std::vector<FakeTensor>& tensors, Wrapper wrapper = Wrapper::kModel);
 
 struct ZipEntry {
   std::string name;

@@ -27,8 +27,7 @@ void expect_error(const std::filesystem::path& path, Kind kind, const std::strin
     const std::string message = e.what();
     EXPECT_EQ(static_cast<int>(e.kind()), static_cast<int>(kind)) << message;
     EXPECT_NE(message.find(needle), std::string::npos) << message;
-    EXPECT_NE(message.find(path.string()), std::string::npos) << "message must name the file: "
-                                                              << message;
+    EXPECT_NE(message.find(path.string()), std::string::npos) << "message must name the file: " << message;
   }
 }
 
@@ -40,8 +39,7 @@ void expect_no_crash(const std::filesystem::path& path) {
   }
 }
 
-std::filesystem::path write_pickle(const TempDir& dir, const std::string& name,
-                                   const std::string& pickle,
+std::filesystem::path write_pickle(const TempDir& dir, const std::string& name, const std::string& pickle,
                                    std::vector<std::pair<std::string, std::string>> storages = {}) {
   FakeCheckpoint ckpt;
   ckpt.pickle_override = pickle;
@@ -53,9 +51,9 @@ std::filesystem::path write_pickle(const TempDir& dir, const std::string& name,
 FakeCheckpoint small_checkpoint() {
   FakeCheckpoint ckpt;
   ckpt.wrapper = Wrapper::kOrderedDictWithMetadata;
-  ckpt.tensors = {{.name = "a.weight", .storage_key = "0", .storage_numel = 4, .size = {2, 2}},
-                  {.name = "a.bias", .storage_type = "HalfStorage", .storage_key = "1",
-                   .storage_numel = 2, .size = {2}}};
+  ckpt.tensors = {
+      {.name = "a.weight", .storage_key = "0", .storage_numel = 4, .size = {2, 2}},
+      {.name = "a.bias", .storage_type = "HalfStorage", .storage_key = "1", .storage_numel = 2, .size = {2}}};
   ckpt.storages = {{"0", le_floats({1, 2, 3, 4})}, {"1", le_u16({0x3c00, 0x4000})}};
   return ckpt;
 }
@@ -63,8 +61,7 @@ FakeCheckpoint small_checkpoint() {
 // --- security --------------------------------------------------------------------------------
 
 // A pickle that would run `touch <marker>` under pickle.load.
-std::string exploit(const std::string& module, const std::string& name, const std::string& marker,
-                    bool stack_global) {
+std::string exploit(const std::string& module, const std::string& name, const std::string& marker, bool stack_global) {
   PickleWriter w;
   w.proto(stack_global ? 4 : 2);
   if (stack_global) {
@@ -78,18 +75,23 @@ std::string exploit(const std::string& module, const std::string& name, const st
 
 TEST(CheckpointSecurity, DisallowedGlobalsAreRejectedByName) {
   const std::pair<std::string, std::string> globals[] = {
-      {"os", "system"},        {"posix", "system"},     {"builtins", "eval"},
-      {"builtins", "exec"},    {"subprocess", "Popen"}, {"__builtin__", "getattr"},
-      {"torch", "load"},       {"torch._utils", "_rebuild_tensor"},
-      {"collections", "defaultdict"}, {"torch.serialization", "_get_layout"},
+      {"os", "system"},
+      {"posix", "system"},
+      {"builtins", "eval"},
+      {"builtins", "exec"},
+      {"subprocess", "Popen"},
+      {"__builtin__", "getattr"},
+      {"torch", "load"},
+      {"torch._utils", "_rebuild_tensor"},
+      {"collections", "defaultdict"},
+      {"torch.serialization", "_get_layout"},
   };
   for (const bool stack_global : {false, true}) {
     for (const auto& [module, name] : globals) {
       SCOPED_TRACE(module + "." + name + (stack_global ? " via STACK_GLOBAL" : " via GLOBAL"));
       TempDir dir;
       const auto marker = dir / "pwned";
-      const auto path =
-          write_pickle(dir, "evil.pth", exploit(module, name, marker.string(), stack_global));
+      const auto path = write_pickle(dir, "evil.pth", exploit(module, name, marker.string(), stack_global));
       expect_error(path, Kind::kUnsafe, "disallowed global '" + module + "." + name + "'");
       EXPECT_FALSE(std::filesystem::exists(marker));
     }
@@ -175,7 +177,8 @@ TEST(CheckpointMalformed, LegacyFormatIsExplained) {
   TempDir dir;
   // The legacy format starts with a protocol-2 pickle of torch's magic number.
   write_file(dir / "legacy.pth", std::string("\x80\x02\x8a\x0a\x6c\xfc\x9c\x46\xf9\x20\x6a\xa8\x50"
-                                             "\x19.\x80\x02M\xe9\x03.", 21));
+                                             "\x19.\x80\x02M\xe9\x03.",
+                                             21));
   expect_error(dir / "legacy.pth", Kind::kUnsupported, "legacy");
   expect_error(dir / "legacy.pth", Kind::kUnsupported, "torch.save(torch.load(");
 }
@@ -213,23 +216,19 @@ TEST(CheckpointMalformed, TensorOutsideItsStorage) {
     std::string needle;
   } cases[] = {
       {{.name = "big", .storage_key = "0", .storage_numel = 4, .size = {5}}, "does not fit"},
-      {{.name = "off", .storage_key = "0", .storage_numel = 4, .offset = 3, .size = {2}},
-       "does not fit"},
-      {{.name = "far", .storage_key = "0", .storage_numel = 4, .offset = 9, .size = {0}},
-       "beyond its storage"},
-      {{.name = "stride", .storage_key = "0", .storage_numel = 4, .size = {2, 2},
-        .stride = {3, 1}},
-       "does not fit"},
-      {{.name = "huge", .storage_key = "0", .storage_numel = 4, .size = {1000000, 1000000}},
-       "does not fit"},
-      {{.name = "bcast", .storage_key = "0", .storage_numel = 4, .size = {1000000, 1000000},
-        .stride = {0, 0}},
+      {{.name = "off", .storage_key = "0", .storage_numel = 4, .offset = 3, .size = {2}}, "does not fit"},
+      {{.name = "far", .storage_key = "0", .storage_numel = 4, .offset = 9, .size = {0}}, "beyond its storage"},
+      {{.name = "stride", .storage_key = "0", .storage_numel = 4, .size = {2, 2}, .stride = {3, 1}}, "does not fit"},
+      {{.name = "huge", .storage_key = "0", .storage_numel = 4, .size = {1000000, 1000000}}, "does not fit"},
+      {{.name = "bcast", .storage_key = "0", .storage_numel = 4, .size = {1000000, 1000000}, .stride = {0, 0}},
        "more elements than its storage"},
-      {{.name = "overflow", .storage_key = "0", .storage_numel = 4,
-        .size = {int64_t{1} << 31, int64_t{1} << 31, int64_t{1} << 31}, .stride = {1, 1, 1}},
+      {{.name = "overflow",
+        .storage_key = "0",
+        .storage_numel = 4,
+        .size = {int64_t{1} << 31, int64_t{1} << 31, int64_t{1} << 31},
+        .stride = {1, 1, 1}},
        "absurdly large"},
-      {{.name = "wrap", .storage_key = "0", .storage_numel = 4, .size = {2},
-        .stride = {int64_t{1} << 62}},
+      {{.name = "wrap", .storage_key = "0", .storage_numel = 4, .size = {2}, .stride = {int64_t{1} << 62}},
        "does not fit"},
   };
   for (const auto& c : cases) {
@@ -238,8 +237,7 @@ TEST(CheckpointMalformed, TensorOutsideItsStorage) {
     ckpt.tensors = {c.tensor};
     ckpt.storages = {{"0", le_floats({1, 2, 3, 4})}};
     ckpt.write(dir / "t.pth");
-    expect_error(dir / "t.pth", c.needle == "more elements than its storage" ? Kind::kUnsupported
-                                                                             : Kind::kFormat,
+    expect_error(dir / "t.pth", c.needle == "more elements than its storage" ? Kind::kUnsupported : Kind::kFormat,
                  c.needle);
   }
 }
@@ -248,8 +246,8 @@ TEST(CheckpointMalformed, AbsurdStorageSizeDoesNotAllocate) {
   // A persistent id claiming 1e12 elements with 16 bytes of data: refused before reading.
   TempDir dir;
   FakeCheckpoint ckpt;
-  ckpt.tensors = {{.name = "t", .storage_key = "0", .storage_numel = 1'000'000'000'000,
-                   .size = {1'000'000, 1'000'000}}};
+  ckpt.tensors = {
+      {.name = "t", .storage_key = "0", .storage_numel = 1'000'000'000'000, .size = {1'000'000, 1'000'000}}};
   ckpt.storages = {{"0", le_floats({1, 2, 3, 4})}};
   ckpt.write(dir / "a.pth");
   expect_error(dir / "a.pth", Kind::kFormat, "declares 1000000000000 float32 elements");
@@ -269,9 +267,8 @@ TEST(CheckpointMalformed, TruncatedFixture) {
   NEUFLOW_REQUIRE_FIXTURE(fixture, "neuflow-v2-seed0/checkpoint.pth");
   const std::string bytes = read_file(fixture);
   TempDir dir;
-  for (const std::size_t n : {std::size_t{1}, std::size_t{4}, std::size_t{30}, std::size_t{100},
-                              std::size_t{17000}, std::size_t{20000}, bytes.size() / 2,
-                              bytes.size() - 100, bytes.size() - 1}) {
+  for (const std::size_t n : {std::size_t{1}, std::size_t{4}, std::size_t{30}, std::size_t{100}, std::size_t{17000},
+                              std::size_t{20000}, bytes.size() / 2, bytes.size() - 100, bytes.size() - 1}) {
     SCOPED_TRACE(n);
     write_file(dir / "cut.pth", std::string_view(bytes).substr(0, n));
     try {
@@ -359,46 +356,81 @@ TEST(CheckpointMalformed, PickleStructureErrors) {
       {"underflow", PickleWriter().proto(2).setitem().bytes(), Kind::kFormat, "underflow"},
       {"empty stop", PickleWriter().proto(2).stop().bytes(), Kind::kFormat, "underflow"},
       {"bad memo", PickleWriter().proto(2).get(7).stop().bytes(), Kind::kFormat, "memo entry 7"},
-      {"huge memo", PickleWriter().proto(2).empty_dict().put(0xfffffff0u).stop().bytes(),
-       Kind::kFormat, "memo index"},
-      {"no mark", PickleWriter().proto(2).empty_dict().setitems().bytes(), Kind::kFormat,
-       "MARK"},
-      {"odd setitems", PickleWriter().proto(2).empty_dict().mark().integer(1).setitems().bytes(),
-       Kind::kFormat, "odd"},
-      {"setitem on list", PickleWriter().proto(2).empty_list().integer(1).integer(2).setitem()
-           .bytes(), Kind::kFormat, "SETITEM(S) on a list"},
-      {"append on dict", PickleWriter().proto(2).empty_dict().integer(1).append().bytes(),
-       Kind::kFormat, "APPEND(S) on a dict"},
-      {"huge string", PickleWriter().proto(2).raw(std::string("X\xff\xff\xff\xff", 5)).bytes(),
-       Kind::kFormat, "exceeds the limit"},
-      {"string past end", PickleWriter().proto(2).raw(std::string("X\x10\x00\x00\x00" "ab", 7))
-           .bytes(), Kind::kFormat, "truncated"},
-      {"long1 too long", PickleWriter().proto(2).raw(std::string("\x8a\x09", 2)).raw(
-           std::string(9, '\x01')).stop().bytes(), Kind::kUnsupported, "LONG1"},
+      {"huge memo", PickleWriter().proto(2).empty_dict().put(0xfffffff0u).stop().bytes(), Kind::kFormat, "memo index"},
+      {"no mark", PickleWriter().proto(2).empty_dict().setitems().bytes(), Kind::kFormat, "MARK"},
+      {"odd setitems", PickleWriter().proto(2).empty_dict().mark().integer(1).setitems().bytes(), Kind::kFormat, "odd"},
+      {"setitem on list", PickleWriter().proto(2).empty_list().integer(1).integer(2).setitem().bytes(), Kind::kFormat,
+       "SETITEM(S) on a list"},
+      {"append on dict", PickleWriter().proto(2).empty_dict().integer(1).append().bytes(), Kind::kFormat,
+       "APPEND(S) on a dict"},
+      {"huge string", PickleWriter().proto(2).raw(std::string("X\xff\xff\xff\xff", 5)).bytes(), Kind::kFormat,
+       "exceeds the limit"},
+      {"string past end",
+       PickleWriter()
+           .proto(2)
+           .raw(std::string("X\x10\x00\x00\x00"
+                            "ab",
+                            7))
+           .bytes(),
+       Kind::kFormat, "truncated"},
+      {"long1 too long",
+       PickleWriter().proto(2).raw(std::string("\x8a\x09", 2)).raw(std::string(9, '\x01')).stop().bytes(),
+       Kind::kUnsupported, "LONG1"},
       {"protocol 6", PickleWriter().proto(6).stop().bytes(), Kind::kUnsupported, "protocol 6"},
       {"protocol 1", PickleWriter().proto(1).stop().bytes(), Kind::kUnsupported, "protocol 1"},
-      {"endless global", PickleWriter().proto(2).raw("ctorch\n").raw(std::string(1000, 'a'))
-           .bytes(), Kind::kFormat, "GLOBAL"},
+      {"endless global", PickleWriter().proto(2).raw("ctorch\n").raw(std::string(1000, 'a')).bytes(), Kind::kFormat,
+       "GLOBAL"},
       {"top-level list", PickleWriter().proto(2).empty_list().stop().bytes(), Kind::kUnsupported,
        "is a list, not a dict"},
-      {"int in state dict", PickleWriter().proto(2).empty_dict().str("model").empty_dict()
-           .str("a.weight").integer(5).setitem().setitem().stop().bytes(),
+      {"int in state dict",
+       PickleWriter()
+           .proto(2)
+           .empty_dict()
+           .str("model")
+           .empty_dict()
+           .str("a.weight")
+           .integer(5)
+           .setitem()
+           .setitem()
+           .stop()
+           .bytes(),
        Kind::kUnsupported, "'a.weight' is a int, not a tensor"},
-      {"model is a list", PickleWriter().proto(2).empty_dict().str("model").empty_list()
-           .setitem().stop().bytes(), Kind::kUnsupported, "'model' is a list"},
-      {"not a state dict", PickleWriter().proto(2).empty_dict().str("epoch").integer(3)
-           .setitem().stop().bytes(), Kind::kUnsupported, "neither a 'model' nor"},
-      {"int key", PickleWriter().proto(2).empty_dict().str("model").empty_dict().integer(3)
-           .none().setitem().setitem().stop().bytes(), Kind::kFormat, "key of type int"},
-      {"bad persistent id", PickleWriter().proto(2).str("x").binpersid().stop().bytes(),
-       Kind::kFormat, "persistent id"},
-      {"persid with evil key", PickleWriter().proto(2).mark().str("storage")
-           .global("torch", "FloatStorage").str("../../etc/passwd").str("cpu").integer(1)
-           .tuple().binpersid().stop().bytes(), Kind::kFormat, "invalid storage key"},
-      {"stop inside mark", PickleWriter().proto(2).none().mark().stop().bytes(), Kind::kFormat,
-       "STOP inside"},
-      {"build on list", PickleWriter().proto(2).empty_list().none().build().stop().bytes(),
-       Kind::kUnsupported, "BUILD on a list"},
+      {"model is a list", PickleWriter().proto(2).empty_dict().str("model").empty_list().setitem().stop().bytes(),
+       Kind::kUnsupported, "'model' is a list"},
+      {"not a state dict", PickleWriter().proto(2).empty_dict().str("epoch").integer(3).setitem().stop().bytes(),
+       Kind::kUnsupported, "neither a 'model' nor"},
+      {"int key",
+       PickleWriter()
+           .proto(2)
+           .empty_dict()
+           .str("model")
+           .empty_dict()
+           .integer(3)
+           .none()
+           .setitem()
+           .setitem()
+           .stop()
+           .bytes(),
+       Kind::kFormat, "key of type int"},
+      {"bad persistent id", PickleWriter().proto(2).str("x").binpersid().stop().bytes(), Kind::kFormat,
+       "persistent id"},
+      {"persid with evil key",
+       PickleWriter()
+           .proto(2)
+           .mark()
+           .str("storage")
+           .global("torch", "FloatStorage")
+           .str("../../etc/passwd")
+           .str("cpu")
+           .integer(1)
+           .tuple()
+           .binpersid()
+           .stop()
+           .bytes(),
+       Kind::kFormat, "invalid storage key"},
+      {"stop inside mark", PickleWriter().proto(2).none().mark().stop().bytes(), Kind::kFormat, "STOP inside"},
+      {"build on list", PickleWriter().proto(2).empty_list().none().build().stop().bytes(), Kind::kUnsupported,
+       "BUILD on a list"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
@@ -427,8 +459,7 @@ TEST(CheckpointMalformed, DeepMarksAndLongPicklesAreBounded) {
 TEST(PickleReader, LimitsAreConfigurable) {
   using model::detail::PickleLimits;
   using model::detail::unpickle;
-  const std::string p = PickleWriter().proto(2).mark().str("abc").integer(1).integer(2).tuple()
-                            .stop().bytes();
+  const std::string p = PickleWriter().proto(2).mark().str("abc").integer(1).integer(2).tuple().stop().bytes();
   const auto* data = reinterpret_cast<const unsigned char*>(p.data());
   EXPECT_NO_THROW((void)unpickle(data, p.size()));
   PickleLimits small_strings;
@@ -457,13 +488,12 @@ TEST(PickleReader, IntegersAndFloats) {
   using model::detail::unpickle;
   PickleWriter w;
   w.proto(2).mark();
-  const int64_t values[] = {0, 255, 256, 65535, 65536, -1, INT32_MIN, INT32_MAX,
-                            int64_t{1} << 40, -(int64_t{1} << 40), INT64_MAX, INT64_MIN};
+  const int64_t values[] = {
+      0, 255, 256, 65535, 65536, -1, INT32_MIN, INT32_MAX, int64_t{1} << 40, -(int64_t{1} << 40), INT64_MAX, INT64_MIN};
   for (const int64_t v : values) w.integer(v);
   w.raw(std::string("\x8a\x00", 2));  // LONG1 of zero bytes: 0
   w.real(-1.5).boolean(true).none().tuple().stop();
-  const auto result =
-      unpickle(reinterpret_cast<const unsigned char*>(w.bytes().data()), w.bytes().size());
+  const auto result = unpickle(reinterpret_cast<const unsigned char*>(w.bytes().data()), w.bytes().size());
   const auto& items = std::get<model::detail::TupleValue>(result.root().v).items;
   ASSERT_EQ(items.size(), std::size(values) + 4);
   for (std::size_t i = 0; i < std::size(values); ++i) {

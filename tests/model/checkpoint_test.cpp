@@ -26,8 +26,7 @@ TEST(CheckpointFixture, LoadsAllTensorsOfThePublishedFormat) {
   NEUFLOW_REQUIRE_FIXTURE(path, "neuflow-v2-seed0/checkpoint.pth");
   const auto start = std::chrono::steady_clock::now();
   const Checkpoint ckpt = load_checkpoint(path);
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   RecordProperty("load_ms", std::to_string(ms));
   std::printf("fixture checkpoint loaded in %.1f ms\n", ms);
 
@@ -127,8 +126,7 @@ TEST(CheckpointDtypes, Float16IsConvertedExactly) {
   TempDir dir;
   const std::vector<uint16_t> bits = {0x3c00, 0xc000, 0x7bff, 0x0001, 0x03ff, 0x3800,
                                       0x8000, 0x7c00, 0xfc00, 0x3555, 0x0400};
-  FakeTensor t{.name = "h", .storage_type = "HalfStorage", .storage_key = "0",
-               .storage_numel = 11, .size = {11}};
+  FakeTensor t{.name = "h", .storage_type = "HalfStorage", .storage_key = "0", .storage_numel = 11, .size = {11}};
   const Checkpoint ckpt = load_one(dir, t, le_u16(bits));
   const auto& h = ckpt.at("h");
   EXPECT_EQ(h.dtype, "float16");
@@ -136,28 +134,26 @@ TEST(CheckpointDtypes, Float16IsConvertedExactly) {
   EXPECT_EQ(h.data[0], 1.0f);
   EXPECT_EQ(h.data[1], -2.0f);
   EXPECT_EQ(h.data[2], 65504.0f);
-  EXPECT_EQ(h.data[3], std::ldexp(1.0f, -24));           // smallest subnormal
-  EXPECT_EQ(h.data[4], std::ldexp(1023.0f, -24));        // largest subnormal
+  EXPECT_EQ(h.data[3], std::ldexp(1.0f, -24));     // smallest subnormal
+  EXPECT_EQ(h.data[4], std::ldexp(1023.0f, -24));  // largest subnormal
   EXPECT_EQ(h.data[5], 0.5f);
   EXPECT_EQ(h.data[6], 0.0f);
   EXPECT_TRUE(std::signbit(h.data[6]));
   EXPECT_EQ(h.data[7], std::numeric_limits<float>::infinity());
   EXPECT_EQ(h.data[8], -std::numeric_limits<float>::infinity());
   EXPECT_EQ(h.data[9], 0.333251953125f);
-  EXPECT_EQ(h.data[10], std::ldexp(1.0f, -14));          // smallest normal
+  EXPECT_EQ(h.data[10], std::ldexp(1.0f, -14));  // smallest normal
 }
 
 TEST(CheckpointDtypes, Float16NanStaysNan) {
   TempDir dir;
-  FakeTensor t{.name = "h", .storage_type = "HalfStorage", .storage_key = "0",
-               .storage_numel = 1, .size = {1}};
+  FakeTensor t{.name = "h", .storage_type = "HalfStorage", .storage_key = "0", .storage_numel = 1, .size = {1}};
   EXPECT_TRUE(std::isnan(load_one(dir, t, le_u16({0x7e00})).at("h").data[0]));
 }
 
 TEST(CheckpointDtypes, BFloat16IsConvertedExactly) {
   TempDir dir;
-  FakeTensor t{.name = "b", .storage_type = "BFloat16Storage", .storage_key = "7",
-               .storage_numel = 4, .size = {2, 2}};
+  FakeTensor t{.name = "b", .storage_type = "BFloat16Storage", .storage_key = "7", .storage_numel = 4, .size = {2, 2}};
   const Checkpoint ckpt = load_one(dir, t, le_u16({0x3f80, 0xc040, 0x4049, 0x0000}));
   const auto& b = ckpt.at("b");
   EXPECT_EQ(b.dtype, "bfloat16");
@@ -169,16 +165,12 @@ TEST(CheckpointDtypes, DoubleAndIntegersAreConverted) {
   TempDir dir;
   FakeCheckpoint ckpt;
   ckpt.tensors = {
-      {.name = "d", .storage_type = "DoubleStorage", .storage_key = "0", .storage_numel = 3,
-       .size = {3}},
-      {.name = "l", .storage_type = "LongStorage", .storage_key = "1", .storage_numel = 2,
-       .size = {2}},
-      {.name = "i", .storage_type = "IntStorage", .storage_key = "2", .storage_numel = 2,
-       .size = {2}},
+      {.name = "d", .storage_type = "DoubleStorage", .storage_key = "0", .storage_numel = 3, .size = {3}},
+      {.name = "l", .storage_type = "LongStorage", .storage_key = "1", .storage_numel = 2, .size = {2}},
+      {.name = "i", .storage_type = "IntStorage", .storage_key = "2", .storage_numel = 2, .size = {2}},
   };
-  ckpt.storages = {{"0", le_doubles({0.1, -1e300, 2.5})},
-                   {"1", le_i64({-5, int64_t{1} << 40})},
-                   {"2", le_i32({-7, 123456})}};
+  ckpt.storages = {
+      {"0", le_doubles({0.1, -1e300, 2.5})}, {"1", le_i64({-5, int64_t{1} << 40})}, {"2", le_i32({-7, 123456})}};
   ckpt.write(dir / "c.pth");
   const Checkpoint loaded = load_checkpoint(dir / "c.pth");
   EXPECT_EQ(loaded.at("d").dtype, "float64");
@@ -195,10 +187,8 @@ TEST(CheckpointDtypes, BigEndianStoragesAreSwapped) {
   TempDir dir;
   FakeCheckpoint ckpt;
   ckpt.tensors = {{.name = "f", .storage_key = "0", .storage_numel = 2, .size = {2}},
-                  {.name = "h", .storage_type = "HalfStorage", .storage_key = "1",
-                   .storage_numel = 1, .size = {1}}};
-  ckpt.storages = {{"0", std::string("\x3f\x80\x00\x00\xc0\x00\x00\x00", 8)},
-                   {"1", std::string("\x3c\x00", 2)}};
+                  {.name = "h", .storage_type = "HalfStorage", .storage_key = "1", .storage_numel = 1, .size = {1}}};
+  ckpt.storages = {{"0", std::string("\x3f\x80\x00\x00\xc0\x00\x00\x00", 8)}, {"1", std::string("\x3c\x00", 2)}};
   auto entries = ckpt.entries();
   entries.push_back({"archive/byteorder", "big"});
   write_zip(dir / "be.pth", entries);
@@ -221,24 +211,23 @@ TEST(CheckpointViews, NonContiguousStridesAndOffsetsAreGathered) {
   FakeCheckpoint ckpt;
   ckpt.tensors = {
       // The transpose of a 2x3 matrix [[0,1,2],[3,4,5]].
-      {.name = "transposed", .storage_key = "0", .storage_numel = 12, .size = {3, 2},
-       .stride = {1, 3}},
+      {.name = "transposed", .storage_key = "0", .storage_numel = 12, .size = {3, 2}, .stride = {1, 3}},
       // A 2x2 window at offset 5 of a 3x4 matrix.
-      {.name = "window", .storage_key = "0", .storage_numel = 12, .offset = 5, .size = {2, 2},
-       .stride = {4, 1}},
+      {.name = "window", .storage_key = "0", .storage_numel = 12, .offset = 5, .size = {2, 2}, .stride = {4, 1}},
       // Every other element, from offset 1.
-      {.name = "strided", .storage_key = "0", .storage_numel = 12, .offset = 1, .size = {6},
-       .stride = {2}},
+      {.name = "strided", .storage_key = "0", .storage_numel = 12, .offset = 1, .size = {6}, .stride = {2}},
       // A contiguous slice at an offset, and a 3-d permuted view.
       {.name = "slice", .storage_key = "0", .storage_numel = 12, .offset = 10, .size = {2}},
-      {.name = "permuted", .storage_key = "0", .storage_numel = 12, .size = {2, 3, 2},
-       .stride = {1, 4, 2}},
+      {.name = "permuted", .storage_key = "0", .storage_numel = 12, .size = {2, 3, 2}, .stride = {1, 4, 2}},
       // A row broadcast over two rows (stride 0), within the storage's element count.
-      {.name = "broadcast", .storage_key = "0", .storage_numel = 12, .size = {2, 3},
-       .stride = {0, 1}},
+      {.name = "broadcast", .storage_key = "0", .storage_numel = 12, .size = {2, 3}, .stride = {0, 1}},
       // Zero-size and size-1 dimensions with arbitrary strides.
       {.name = "empty", .storage_key = "0", .storage_numel = 12, .size = {0, 4}},
-      {.name = "ones", .storage_key = "0", .storage_numel = 12, .offset = 7, .size = {1, 1, 2},
+      {.name = "ones",
+       .storage_key = "0",
+       .storage_numel = 12,
+       .offset = 7,
+       .size = {1, 1, 2},
        .stride = {99, 1000, 1}},
   };
   ckpt.storages = {{"0", le_floats(iota(12))}};
@@ -248,8 +237,7 @@ TEST(CheckpointViews, NonContiguousStridesAndOffsetsAreGathered) {
   EXPECT_EQ(loaded.at("window").data, (std::vector<float>{5, 6, 9, 10}));
   EXPECT_EQ(loaded.at("strided").data, (std::vector<float>{1, 3, 5, 7, 9, 11}));
   EXPECT_EQ(loaded.at("slice").data, (std::vector<float>{10, 11}));
-  EXPECT_EQ(loaded.at("permuted").data,
-            (std::vector<float>{0, 2, 4, 6, 8, 10, 1, 3, 5, 7, 9, 11}));
+  EXPECT_EQ(loaded.at("permuted").data, (std::vector<float>{0, 2, 4, 6, 8, 10, 1, 3, 5, 7, 9, 11}));
   EXPECT_EQ(loaded.at("broadcast").data, (std::vector<float>{0, 1, 2, 0, 1, 2}));
   EXPECT_TRUE(loaded.at("empty").data.empty());
   EXPECT_EQ(loaded.at("empty").shape, (std::vector<int64_t>{0, 4}));
@@ -258,8 +246,13 @@ TEST(CheckpointViews, NonContiguousStridesAndOffsetsAreGathered) {
 
 TEST(CheckpointViews, StridedHalfViews) {
   TempDir dir;
-  FakeTensor t{.name = "h", .storage_type = "HalfStorage", .storage_key = "0",
-               .storage_numel = 4, .offset = 1, .size = {2}, .stride = {2}};
+  FakeTensor t{.name = "h",
+               .storage_type = "HalfStorage",
+               .storage_key = "0",
+               .storage_numel = 4,
+               .offset = 1,
+               .size = {2},
+               .stride = {2}};
   const Checkpoint ckpt = load_one(dir, t, le_u16({0x3c00, 0x4000, 0x4200, 0x4400}));
   EXPECT_EQ(ckpt.at("h").data, (std::vector<float>{2.0f, 4.0f}));
 }
@@ -362,8 +355,7 @@ TEST(CheckpointWrappers, CompressedEntriesAreRead) {
 TEST(CheckpointWrappers, ParametersAndSharedStorages) {
   TempDir dir;
   FakeCheckpoint ckpt;
-  ckpt.tensors = {{.name = "p", .storage_key = "0", .storage_numel = 6, .size = {3},
-                   .as_parameter = true},
+  ckpt.tensors = {{.name = "p", .storage_key = "0", .storage_numel = 6, .size = {3}, .as_parameter = true},
                   {.name = "q", .storage_key = "0", .storage_numel = 6, .offset = 3, .size = {3}}};
   ckpt.storages = {{"0", le_floats(iota(6))}};
   ckpt.write(dir / "p.pth");

@@ -69,7 +69,8 @@ float naive_conv(const ConvWeights& w, const Tensor& in, int stride, int pad, in
       for (int kx = 0; kx < w.kernel_w; ++kx) {
         const int iy = oy * stride - pad + ky, ix = ox * stride - pad + kx;
         if (iy < 0 || ix < 0 || iy >= in.h || ix >= in.w) continue;
-        s += static_cast<double>(w.weight[((static_cast<std::size_t>(oc) * w.in_channels + ic) * w.kernel_h + ky) * w.kernel_w + kx]) *
+        s += static_cast<double>(
+                 w.weight[((static_cast<std::size_t>(oc) * w.in_channels + ic) * w.kernel_h + ky) * w.kernel_w + kx]) *
              in.pixel(iy, ix)[ic];
       }
   return static_cast<float>(s);
@@ -90,7 +91,8 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
   const ConvCase p = std::get<0>(GetParam());
   const CpuConvolution algorithm = std::get<1>(GetParam());
   std::mt19937 rng(11);
-  ConvWeights w{p.out_c, p.in_c, p.k, p.k, std::vector<float>(static_cast<std::size_t>(p.out_c) * p.in_c * p.k * p.k), {}};
+  ConvWeights w{p.out_c, p.in_c, p.k, p.k, std::vector<float>(static_cast<std::size_t>(p.out_c) * p.in_c * p.k * p.k),
+                {}};
   fill_random(w.weight, rng, 0.1f);
   if (p.bias) {
     w.bias.resize(p.out_c);
@@ -124,10 +126,17 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
         float e = naive_conv(w, in, p.stride, p.pad, y, x, c);
         if (p.accumulate) e += addend_t.pixel(y, x)[c];
         switch (p.act) {
-          case Activation::none: break;
-          case Activation::relu: e = std::max(e, 0.f); break;
-          case Activation::leaky_relu: e = e < 0 ? 0.1f * e : e; break;
-          case Activation::gelu: e = 0.5f * e * (1.f + std::erf(e / std::sqrt(2.f))); break;
+          case Activation::none:
+            break;
+          case Activation::relu:
+            e = std::max(e, 0.f);
+            break;
+          case Activation::leaky_relu:
+            e = e < 0 ? 0.1f * e : e;
+            break;
+          case Activation::gelu:
+            e = 0.5f * e * (1.f + std::erf(e / std::sqrt(2.f)));
+            break;
         }
         ASSERT_NEAR(out.pixel(y, x)[c], e, 1e-4f * (1.f + std::fabs(e)))
             << "in_c " << p.in_c << " out_c " << p.out_c << " k " << p.k << " stride " << p.stride << " pad " << p.pad
@@ -137,36 +146,39 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
 
 // The shapes the network uses: the backbone's strided first convolutions on 3 channels,
 // channel counts that are not multiples of 8, fused activations and the accumulate path.
-INSTANTIATE_TEST_SUITE_P(NetworkShapes, ConvOpTest,
-                         ::testing::Combine(::testing::Values(ConvCase{3, 16, 8, 4, 2, 24, 32, false, Activation::leaky_relu, false},
-                                           ConvCase{3, 16, 6, 2, 2, 12, 16, false, Activation::leaky_relu, false},
-                                           ConvCase{3, 8, 8, 8, 0, 16, 24, false, Activation::leaky_relu, false},
-                                           ConvCase{147, 24, 3, 1, 1, 5, 7, false, Activation::leaky_relu, true},
-                                           ConvCase{96, 66, 3, 1, 1, 6, 5, true, Activation::none, false},
-                                           ConvCase{130, 32, 3, 1, 1, 4, 6, true, Activation::relu, false},
-                                           ConvCase{64, 40, 1, 1, 0, 4, 4, true, Activation::none, false},
-                                           ConvCase{40, 24, 3, 1, 1, 5, 5, false, Activation::gelu, false},
-                                           // Several tiles, borders cut inside a tile, channels past one block.
-                                           ConvCase{20, 36, 3, 1, 1, 13, 18, true, Activation::leaky_relu, true},
-                                           // 6×6 stride 2 (block_8_16): by space-to-depth on 16 channels
-                                           // (a 7×9 view: border tiles only; 15×17: whole ones too),
-                                           // and on an odd-sized input, directly.
-                                           ConvCase{16, 24, 6, 2, 2, 14, 18, true, Activation::leaky_relu, false},
-                                           ConvCase{16, 24, 6, 2, 2, 30, 34, true, Activation::leaky_relu, false},
-                                           ConvCase{16, 24, 6, 2, 2, 13, 18, true, Activation::leaky_relu, false}),
-                                           ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd4,
-                                                             CpuConvolution::winograd6)));
+INSTANTIATE_TEST_SUITE_P(
+    NetworkShapes, ConvOpTest,
+    ::testing::Combine(::testing::Values(ConvCase{3, 16, 8, 4, 2, 24, 32, false, Activation::leaky_relu, false},
+                                         ConvCase{3, 16, 6, 2, 2, 12, 16, false, Activation::leaky_relu, false},
+                                         ConvCase{3, 8, 8, 8, 0, 16, 24, false, Activation::leaky_relu, false},
+                                         ConvCase{147, 24, 3, 1, 1, 5, 7, false, Activation::leaky_relu, true},
+                                         ConvCase{96, 66, 3, 1, 1, 6, 5, true, Activation::none, false},
+                                         ConvCase{130, 32, 3, 1, 1, 4, 6, true, Activation::relu, false},
+                                         ConvCase{64, 40, 1, 1, 0, 4, 4, true, Activation::none, false},
+                                         ConvCase{40, 24, 3, 1, 1, 5, 5, false, Activation::gelu, false},
+                                         // Several tiles, borders cut inside a tile, channels past one block.
+                                         ConvCase{20, 36, 3, 1, 1, 13, 18, true, Activation::leaky_relu, true},
+                                         // 6×6 stride 2 (block_8_16): by space-to-depth on 16 channels
+                                         // (a 7×9 view: border tiles only; 15×17: whole ones too),
+                                         // and on an odd-sized input, directly.
+                                         ConvCase{16, 24, 6, 2, 2, 14, 18, true, Activation::leaky_relu, false},
+                                         ConvCase{16, 24, 6, 2, 2, 30, 34, true, Activation::leaky_relu, false},
+                                         ConvCase{16, 24, 6, 2, 2, 13, 18, true, Activation::leaky_relu, false}),
+                       ::testing::Values(CpuConvolution::direct, CpuConvolution::winograd4,
+                                         CpuConvolution::winograd6)));
 
 // The arena reuses a released buffer's bytes for buffers made afterwards in the same region,
 // never lets two buffers alive at the same time overlap, and places the largest first: here a
 // buffer made after a small one is released does not fit that one's bytes, and placing buffers
 // as they came would have put it after both (16 KiB), where largest-first needs 12 KiB.
 TEST(ScratchArena, LiveBuffersNeverOverlapAndTheLargestArePlacedFirst) {
-  const auto floats = [](int n) { return dnnl::memory::desc({n}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::a); };
+  const auto floats = [](int n) {
+    return dnnl::memory::desc({n}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::a);
+  };
   ScratchArena arena;
   const dnnl::memory a = arena.make(floats(1024)), b = arena.make(floats(1024));
   arena.release(a);
-  const dnnl::memory c = arena.make(floats(2048));  // alive with b, not with a
+  const dnnl::memory c = arena.make(floats(2048));   // alive with b, not with a
   EXPECT_THROW(arena.release(a), std::logic_error);  // twice
   Tensor t;
   arena.make_tensor(t, 2, 4, 8);  // 256 bytes, alive with b and c
@@ -175,8 +187,8 @@ TEST(ScratchArena, LiveBuffersNeverOverlapAndTheLargestArePlacedFirst) {
   const dnnl::memory f = arena.make(floats(4096));   // overlaps the first region: allowed
   arena.finalize();
   const auto at = [](const dnnl::memory& m) { return static_cast<const char*>(m.get_data_handle()); };
-  EXPECT_EQ(at(c), at(a));              // largest first, at 0; a (not alive with it) there too
-  EXPECT_EQ(at(b), at(c) + 8192);       // b lives with c
+  EXPECT_EQ(at(c), at(a));         // largest first, at 0; a (not alive with it) there too
+  EXPECT_EQ(at(b), at(c) + 8192);  // b lives with c
   EXPECT_EQ(reinterpret_cast<const char*>(t.data.data()), at(b) + 4096);
   EXPECT_TRUE(t.data.is_view());
   EXPECT_EQ(t.data.size(), 64u);

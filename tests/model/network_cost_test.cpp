@@ -21,11 +21,11 @@ TEST(NetworkCost, EveryStageMatchesTheArithmeticByHand) {
     const int h8 = height / 8, w8 = width / 8, h16 = height / 16, w16 = width / 16;
     const double l = static_cast<double>(h16) * w16;
     const NetworkCost c = network_cost(height, width, it);
-    EXPECT_DOUBLE_EQ(c.backbone,
-                     conv(h8, w8, 256, 3, 8) + conv(h8, w8, 256, 256, 3) + conv(h8, w8, 128, 3, 6) +
-                         conv(h8, w8, 128, 128, 3) + conv(h8, w8, 192, 384, 3) + conv(h8, w8, 192, 192, 3) +
-                         conv(h16, w16, 128, 3, 6) + conv(h16, w16, 128, 128, 3) + conv(h16, w16, 128, 192, 6) +
-                         conv(h16, w16, 128, 128, 3) + conv(h16, w16, 190, 256, 3) + conv(h16, w16, 190, 190, 3));
+    EXPECT_DOUBLE_EQ(c.backbone, conv(h8, w8, 256, 3, 8) + conv(h8, w8, 256, 256, 3) + conv(h8, w8, 128, 3, 6) +
+                                     conv(h8, w8, 128, 128, 3) + conv(h8, w8, 192, 384, 3) + conv(h8, w8, 192, 192, 3) +
+                                     conv(h16, w16, 128, 3, 6) + conv(h16, w16, 128, 128, 3) +
+                                     conv(h16, w16, 128, 192, 6) + conv(h16, w16, 128, 128, 3) +
+                                     conv(h16, w16, 190, 256, 3) + conv(h16, w16, 190, 190, 3));
     EXPECT_DOUBLE_EQ(c.upsample_features, conv(h8, w8, 128, 3, 8) + conv(h8, w8, 128, 128, 3));
     const double layer = 2 * l * 192 * 192 * 4 + 2 * l * l * 192 * 2 + 2 * l * 384 * 384 + 2 * l * 384 * 192;
     EXPECT_DOUBLE_EQ(c.cross_attention, 4 * layer);  // two layers, both frames

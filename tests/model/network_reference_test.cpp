@@ -10,9 +10,9 @@
 #include <regex>
 #include <string>
 
+#include "neuflow/flow/npy_format.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
-#include "neuflow/flow/npy_format.hpp"
 #include "support/fixtures.hpp"
 #include "support/vulkan.hpp"
 
@@ -58,8 +58,9 @@ TEST_P(NetworkReference, EveryStageMatchesTheReference) {
   FlowSession session(model, {.iterations = {1, 8}, .threads = 2, .backend = GetParam()});
   std::map<std::string, Captured> seen;
   session.set_observer([&](const StageTensor& t) {
-    seen[key(t.name, t.frame)] = {t.height, t.width, t.channels,
-                                  std::vector<float>(t.data, t.data + static_cast<std::size_t>(t.height) * t.width * t.channels)};
+    seen[key(t.name, t.frame)] = {
+        t.height, t.width, t.channels,
+        std::vector<float>(t.data, t.data + static_cast<std::size_t>(t.height) * t.width * t.channels)};
   });
   const cv::Mat img0 = cv::imread((dir / "frame0.png").string(), cv::IMREAD_COLOR);
   const cv::Mat img1 = cv::imread((dir / "frame1.png").string(), cv::IMREAD_COLOR);

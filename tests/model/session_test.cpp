@@ -174,8 +174,9 @@ TEST_F(SessionTest, UnusableInputsAreRejectedWithAReason) {
   cv::Mat other;
   cv::resize(frames_[1], other, cv::Size(128, 72));
   EXPECT_THROW(session.compute(view_of(frames_[0]), view_of(other)), std::invalid_argument);
-  EXPECT_THROW(FlowSession(model_, {.model_width = 100, .model_height = 64}).compute(view_of(frames_[0]), view_of(frames_[1])),
-               std::invalid_argument);
+  EXPECT_THROW(
+      FlowSession(model_, {.model_width = 100, .model_height = 64}).compute(view_of(frames_[0]), view_of(frames_[1])),
+      std::invalid_argument);
   EXPECT_THROW(FlowSession(model_, {.iterations = {-1, 8}}), std::invalid_argument);
   ImageView bad = view_of(frames_[0]);
   bad.stride = 10;
@@ -235,7 +236,8 @@ TEST_F(SessionTest, SessionsOnSeveralThreadsShareOneModel) {
         const int a = (t + i) % 2;
         const auto f = session.compute(view_of(frames_[a]), view_of(frames_[a + 1]));
         const auto& expected = a == 0 ? expected01 : expected12;
-        for (std::size_t k = 0; k < f.uv.size(); ++k) worst = std::max(worst, static_cast<double>(std::fabs(f.uv[k] - expected.uv[k])));
+        for (std::size_t k = 0; k < f.uv.size(); ++k)
+          worst = std::max(worst, static_cast<double>(std::fabs(f.uv[k] - expected.uv[k])));
       }
       errors[t] = worst;
     });

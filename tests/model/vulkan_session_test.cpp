@@ -52,7 +52,7 @@ Errors compare(const flow::FlowField& a, const flow::FlowField& b) {
 
 // fp16's end-point error against fp32, printed; its bound is relative to the flow's size.
 struct Fp16Error {
-  double epe = 0, worst = 0;         // mean and largest end-point error, px
+  double epe = 0, worst = 0;          // mean and largest end-point error, px
   double magnitude = 0, largest = 0;  // mean and largest |flow| in fp32, px
 };
 
@@ -71,9 +71,10 @@ Fp16Error fp16_error(const flow::FlowField& exact, const flow::FlowField& half, 
   }
   r.epe /= static_cast<double>(std::max<std::size_t>(n, 1));
   r.magnitude /= static_cast<double>(std::max<std::size_t>(n, 1));
-  std::printf("fp16 vs fp32 at %dx%d: mean EPE %.4f px (%.3f %% of the mean |flow| %.2f px), max %.4f px "
-              "(%.3f %% of the largest |flow| %.2f px)\n",
-              w, h, r.epe, 100 * r.epe / r.magnitude, r.magnitude, r.worst, 100 * r.worst / r.largest, r.largest);
+  std::printf(
+      "fp16 vs fp32 at %dx%d: mean EPE %.4f px (%.3f %% of the mean |flow| %.2f px), max %.4f px "
+      "(%.3f %% of the largest |flow| %.2f px)\n",
+      w, h, r.epe, 100 * r.epe / r.magnitude, r.magnitude, r.worst, 100 * r.worst / r.largest, r.largest);
   return r;
 }
 
@@ -319,10 +320,10 @@ TEST_F(VulkanSession, FramesConvertedOnTheDeviceGiveTheCpusFlow) {
   cv::Mat wide0(60, 130, CV_8UC3, cv::Scalar(0, 0, 255)), wide1 = wide0.clone();
   bgr0.copyTo(wide0(cv::Rect(17, 0, 100, 60)));
   bgr1.copyTo(wide1(cv::Rect(17, 0, 100, 60)));
-  EXPECT_EQ(compare(gpu.compute(view_of(wide0(cv::Rect(17, 0, 100, 60))), view_of(wide1(cv::Rect(17, 0, 100, 60)))),
-                    from_bgr)
-                .max,
-            0)
+  EXPECT_EQ(
+      compare(gpu.compute(view_of(wide0(cv::Rect(17, 0, 100, 60))), view_of(wide1(cv::Rect(17, 0, 100, 60)))), from_bgr)
+          .max,
+      0)
       << "rows read at their stride";
 
   SessionOptions resized_gpu = gpu_options, resized_cpu = cpu_options;
@@ -350,7 +351,8 @@ TEST_F(VulkanSession, ADeviceThatDoesNotExistIsAnErrorNamingIt) {
 
 // Each gtest case runs as its own process under ctest, so the budget applies to this one only.
 TEST_F(VulkanSession, RunningOutOfDeviceMemoryIsAnErrorAndAutoFallsBackToTheCpu) {
-  ASSERT_EQ(setenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB", "38", 1), 0);  // the weights (35 MiB) fit, a 208×128 plan does not
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB", "38", 1),
+            0);  // the weights (35 MiB) fit, a 208×128 plan does not
   {
     FlowSession session(model_, {.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0});
     try {
@@ -429,15 +431,16 @@ TEST_F(VulkanSession, Fp16StaysWithinItsBoundOfFp32) {
   for (const auto& d : list_gpu_devices()) fp16 = fp16 || (d.index == 0 && d.fp16);
   if (!fp16) GTEST_SKIP() << "Vulkan device 0 has no fp16";
   FlowSession fp32_session(model_, {.iterations = {1, 4}, .backend = Backend::vulkan, .device = 0});
-  FlowSession fp16_session(model_, {.iterations = {1, 4}, .backend = Backend::vulkan, .device = 0,
-                                    .precision = Precision::fp16});
+  FlowSession fp16_session(
+      model_, {.iterations = {1, 4}, .backend = Backend::vulkan, .device = 0, .precision = Precision::fp16});
   EXPECT_NE(fp16_session.backend_description().find("fp16"), std::string::npos) << fp16_session.backend_description();
   EXPECT_TRUE(fp16_session.fallback_warning().empty()) << fp16_session.fallback_warning();
   for (const auto& [w, h] : std::vector<std::pair<int, int>>{{128, 96}, {200, 120}}) {
     cv::Mat a, b;
     cv::resize(frames_[0], a, cv::Size(w, h));
     cv::resize(frames_[1], b, cv::Size(w, h));
-    const Fp16Error e = fp16_error(fp32_session.compute(view_of(a), view_of(b)), fp16_session.compute(view_of(a), view_of(b)), w, h);
+    const Fp16Error e =
+        fp16_error(fp32_session.compute(view_of(a), view_of(b)), fp16_session.compute(view_of(a), view_of(b)), w, h);
     RecordProperty("fp16_mean_epe_" + std::to_string(w) + "x" + std::to_string(h), std::to_string(e.epe));
     EXPECT_LT(e.epe, 0.005 * e.magnitude) << w << "x" << h;
     EXPECT_LT(e.worst, 0.01 * e.largest) << w << "x" << h;

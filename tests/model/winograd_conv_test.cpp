@@ -40,7 +40,8 @@ std::vector<LayerShape> winograd_layers() {
   std::vector<LayerShape> layers;
   for (const auto& l : neuflow_v2_layers()) {
     if (l.kind == LayerKind::conv && l.kernel == 3) layers.push_back({l.name, l.in, l.out, l.scale});
-    if (l.kind == LayerKind::conv && l.kernel == 6 && l.in % 8 == 0) layers.push_back({l.name, l.in, l.out, l.scale, 2});
+    if (l.kind == LayerKind::conv && l.kernel == 6 && l.in % 8 == 0)
+      layers.push_back({l.name, l.in, l.out, l.scale, 2});
   }
   // The refinements' first convolution runs split: per-iteration inputs and per-pair constants.
   for (const int scale : {8, 16}) {
@@ -75,7 +76,11 @@ TEST_P(WinogradTileForm, MatchesDirectAtEveryNetworkLayer) {
       SCOPED_TRACE(layer.name + " at " + std::to_string(width) + "x" + std::to_string(height));
       const int h = height / layer.scale * layer.stride, w = width / layer.scale * layer.stride;  // the input's
       const int k = 3 * layer.stride;
-      ConvWeights weights{layer.out, layer.in, k, k, std::vector<float>(static_cast<std::size_t>(layer.out) * layer.in * k * k),
+      ConvWeights weights{layer.out,
+                          layer.in,
+                          k,
+                          k,
+                          std::vector<float>(static_cast<std::size_t>(layer.out) * layer.in * k * k),
                           std::vector<float>(static_cast<std::size_t>(layer.out))};
       const float scale = 1.f / std::sqrt(static_cast<float>(k * k * layer.in));
       for (auto& v : weights.weight) v = scale * normal(rng);
@@ -125,7 +130,11 @@ TEST_P(WinogradTileForm, EveryLayoutInAndOutGivesTheDirectResult) {
     const int k = 3 * shape.stride, oh = shape.h / shape.stride, ow = shape.w / shape.stride;
     std::mt19937 rng(11);
     std::normal_distribution<float> normal(0.f, 1.f);
-    ConvWeights weights{shape.out, shape.in, k, k, std::vector<float>(static_cast<std::size_t>(shape.out) * shape.in * k * k),
+    ConvWeights weights{shape.out,
+                        shape.in,
+                        k,
+                        k,
+                        std::vector<float>(static_cast<std::size_t>(shape.out) * shape.in * k * k),
                         std::vector<float>(static_cast<std::size_t>(shape.out))};
     for (auto& v : weights.weight) v = normal(rng) / static_cast<float>(4 * k * k);
     for (auto& v : weights.bias) v = normal(rng);
@@ -192,7 +201,8 @@ TEST(WinogradGemm, EveryKernelMatchesThePortableOne) {
   std::vector<double> expected(static_cast<std::size_t>(kRows) * kColumns, 0.0);
   for (int r = 0; r < kRows; ++r)
     for (int k = 0; k < kDepth; ++k)
-      for (int j = 0; j < kColumns; ++j) expected[r * kColumns + j] += static_cast<double>(a[r * kDepth + k]) * b[k * kColumns + j];
+      for (int j = 0; j < kColumns; ++j)
+        expected[r * kColumns + j] += static_cast<double>(a[r * kDepth + k]) * b[k * kColumns + j];
   for (int i = 0; i < count; ++i) {
     const auto& kernel = *kernels[i];
     SCOPED_TRACE(kernel.name);
@@ -201,7 +211,8 @@ TEST(WinogradGemm, EveryKernelMatchesThePortableOne) {
     std::vector<float> packed(b.size());
     for (int k = 0; k < kDepth; ++k)
       for (int j = 0; j < kColumns; ++j)
-        packed[(static_cast<std::size_t>(j / kernel.panel) * kDepth + k) * kernel.panel + j % kernel.panel] = b[k * kColumns + j];
+        packed[(static_cast<std::size_t>(j / kernel.panel) * kDepth + k) * kernel.panel + j % kernel.panel] =
+            b[k * kColumns + j];
     std::vector<float> c(static_cast<std::size_t>(kRows) * kColumns, -1.f);
     kernel.run(a.data(), packed.data(), c.data(), kRows, kDepth, kColumns);
     for (std::size_t n = 0; n < c.size(); ++n) ASSERT_NEAR(c[n], expected[n], 1e-4) << "at " << n;

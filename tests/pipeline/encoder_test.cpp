@@ -38,7 +38,8 @@ double mean_channel(const RgbFrame& frame, int channel) {
 void encode_colours(const std::filesystem::path& path, int width, int height, int frames) {
   VideoEncoder encoder(path, width, height, FrameRate{10, 1});
   for (int i = 0; i < frames; ++i) {
-    encoder.write(solid(width, height, static_cast<std::uint8_t>(40 * i), 128, static_cast<std::uint8_t>(200 - 30 * i)));
+    encoder.write(
+        solid(width, height, static_cast<std::uint8_t>(40 * i), 128, static_cast<std::uint8_t>(200 - 30 * i)));
   }
   EXPECT_FALSE(std::filesystem::exists(path)) << "visible before finish()";
   encoder.finish();

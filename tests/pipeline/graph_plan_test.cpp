@@ -33,7 +33,8 @@ TEST(GraphPlan, RequiredElementsFollowWhatIsBuilt) {
   V4l2Source mjpeg;
   mjpeg.mjpeg = true;
   EXPECT_TRUE(contains(required_elements(SourceDescription{mjpeg}), "jpegdec"));
-  EXPECT_EQ(required_elements(SourceDescription{UriSource{"file:///a.mp4"}}), (std::vector<std::string>{"uridecodebin"}));
+  EXPECT_EQ(required_elements(SourceDescription{UriSource{"file:///a.mp4"}}),
+            (std::vector<std::string>{"uridecodebin"}));
   EXPECT_TRUE(contains(required_elements(SourceDescription{LibcameraSource{}}), "libcamerasrc"));
   EXPECT_EQ(required_elements(FlowStage{}), (std::vector<std::string>{"videoconvert", "neuflow"}));
 
@@ -45,7 +46,8 @@ TEST(GraphPlan, RequiredElementsFollowWhatIsBuilt) {
   }
   // An RTSP sink needs the server's side too: it encodes and packetizes what the channel carries.
   const auto rtsp = required_elements(SinkDescription{video_to(VideoSink::Target::rtsp)});
-  for (const char* e : {"intervideosink", "intervideosrc", "x264enc", "rtph264pay"}) EXPECT_TRUE(contains(rtsp, e)) << e;
+  for (const char* e : {"intervideosink", "intervideosrc", "x264enc", "rtph264pay"})
+    EXPECT_TRUE(contains(rtsp, e)) << e;
   const auto udp = required_elements(SinkDescription{video_to(VideoSink::Target::udp)});
   for (const char* e : {"x264enc", "rtph264pay", "udpsink"}) EXPECT_TRUE(contains(udp, e)) << e;
 }
@@ -88,8 +90,13 @@ TEST(GraphPlan, SinkElementsAreNamedAfterTheSinkAndFilesContinueEarlierRuns) {
 TEST(GraphPlan, FlowStageCarriesTheSessionSettings) {
   FlowStage flow;
   flow.model = "/m.pth";
-  flow.session = {.iterations = {2, 6}, .model_width = 640, .model_height = 352, .threads = 3,
-                  .network_order = model::ChannelOrder::bgr, .backend = model::Backend::vulkan, .device = 1};
+  flow.session = {.iterations = {2, 6},
+                  .model_width = 640,
+                  .model_height = 352,
+                  .threads = 3,
+                  .network_order = model::ChannelOrder::bgr,
+                  .backend = model::Backend::vulkan,
+                  .device = 1};
   flow.behaviour = "live";
   const ElementChain chain = plan_flow(flow);
   ASSERT_EQ(chain.size(), 2u);
@@ -131,7 +138,8 @@ TEST(ElementChain, LaunchTextQuotesWhatIsNotAPlainWord) {
   ElementSpec mux = element("splitmuxsink");
   mux.children = {{"muxer", element("mp4mux")}};
   EXPECT_THROW(launch_text({mux}), std::logic_error);
-  EXPECT_EQ(factories_of({element("queue"), mux, element("queue")}), (std::vector<std::string>{"queue", "splitmuxsink", "mp4mux"}));
+  EXPECT_EQ(factories_of({element("queue"), mux, element("queue")}),
+            (std::vector<std::string>{"queue", "splitmuxsink", "mp4mux"}));
 }
 
 TEST(ElementChain, MakeElementNamesWhatIsMissing) {

@@ -37,8 +37,8 @@ void run_gst_pipeline(const std::string& description) {
 }
 
 std::filesystem::path make_test_video(const std::filesystem::path& path, int frames, int width, int height) {
-  run_gst_pipeline("videotestsrc num-buffers=" + std::to_string(frames) + " pattern=ball ! video/x-raw,width=" +
-                   std::to_string(width) + ",height=" + std::to_string(height) +
+  run_gst_pipeline("videotestsrc num-buffers=" + std::to_string(frames) +
+                   " pattern=ball ! video/x-raw,width=" + std::to_string(width) + ",height=" + std::to_string(height) +
                    ",framerate=10/1 ! videoconvert ! x264enc ! h264parse ! mp4mux ! filesink location=\"" +
                    path.string() + "\"");
   return path;

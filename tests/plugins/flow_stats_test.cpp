@@ -14,7 +14,7 @@ TEST(FlowStats, CountsFramesInOutFlowsAndDrops) {
   s.restart(t0);
   for (int i = 0; i < 5; ++i) s.frame_in();
   s.dropped(2);
-  s.frame_out(false, 0);     // the first frame: no flow
+  s.frame_out(false, 0);  // the first frame: no flow
   s.frame_out(true, 0.100);
   s.frame_out(true, 0.300);
   EXPECT_EQ(s.frames_in(), 5u);

@@ -81,8 +81,8 @@ inline GstBuffer *make_frame(GstVideoFormat format, int width, int height, std::
 }
 
 inline std::string caps_string(GstVideoFormat format, int width, int height) {
-  return std::string("video/x-raw,format=") + gst_video_format_to_string(format) +
-         ",width=" + std::to_string(width) + ",height=" + std::to_string(height) + ",framerate=30/1";
+  return std::string("video/x-raw,format=") + gst_video_format_to_string(format) + ",width=" + std::to_string(width) +
+         ",height=" + std::to_string(height) + ",framerate=30/1";
 }
 
 // The bytes of pixel (x, y) of a packed frame.
@@ -93,8 +93,9 @@ inline std::vector<std::uint8_t> pixel_bytes(GstBuffer *buffer, GstVideoFormat f
   GstMapInfo map;
   if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return {};
   const int pstride = GST_VIDEO_INFO_COMP_PSTRIDE(&info, 0);
-  const std::size_t offset = static_cast<std::size_t>(y) * static_cast<std::size_t>(GST_VIDEO_INFO_PLANE_STRIDE(&info, 0)) +
-                             static_cast<std::size_t>(x) * static_cast<std::size_t>(pstride);
+  const std::size_t offset =
+      static_cast<std::size_t>(y) * static_cast<std::size_t>(GST_VIDEO_INFO_PLANE_STRIDE(&info, 0)) +
+      static_cast<std::size_t>(x) * static_cast<std::size_t>(pstride);
   std::vector<std::uint8_t> out(map.data + offset, map.data + offset + pstride);
   gst_buffer_unmap(buffer, &map);
   return out;

@@ -14,13 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "neuflow/flow/flow_io.hpp"
 #include "neuflow/gst/flow_meta.h"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 #include "support/vulkan.hpp"
-#include "neuflow/flow/flow_io.hpp"
 
 namespace {
 
@@ -36,7 +36,8 @@ GstBuffer* rgb_buffer(const cv::Mat& rgb, GstClockTime pts) {
 cv::Mat synthetic_frame(int w, int h, int shift) {
   cv::Mat m(h, w, CV_8UC3);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) m.at<cv::Vec3b>(y, x) = cv::Vec3b((x + shift) * 5 & 255, y * 7 & 255, (x + y + shift) * 3 & 255);
+    for (int x = 0; x < w; ++x)
+      m.at<cv::Vec3b>(y, x) = cv::Vec3b((x + shift) * 5 & 255, y * 7 & 255, (x + y + shift) * 3 & 255);
   return m;
 }
 
@@ -99,7 +100,8 @@ TEST_F(NeuflowElement, MetadataEqualsTheCoresFlow) {
   const auto expected = session.compute(view(bgr0), view(bgr1));
   const gfloat* got = neuflow_flow_meta_get_vectors(meta);
   double max_err = 0;
-  for (std::size_t i = 0; i < expected.uv.size(); ++i) max_err = std::max(max_err, static_cast<double>(std::fabs(got[i] - expected.uv[i])));
+  for (std::size_t i = 0; i < expected.uv.size(); ++i)
+    max_err = std::max(max_err, static_cast<double>(std::fabs(got[i] - expected.uv[i])));
   EXPECT_LT(max_err, 1e-5);
   gst_buffer_unref(first);
   gst_buffer_unref(second);
@@ -109,9 +111,11 @@ TEST_F(NeuflowElement, MetadataEqualsTheCoresFlow) {
 TEST_F(NeuflowElement, SizeChangeAndFlushStartANewStreamOfFlows) {
   GstHarness* h = harness("iters-s8=2");
   gst_harness_set_src_caps_str(h, caps_for(64, 48).c_str());
-  for (int i = 0; i < 2; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(synthetic_frame(64, 48, i), i * GST_SECOND / 30)), GST_FLOW_OK);
+  for (int i = 0; i < 2; ++i)
+    ASSERT_EQ(gst_harness_push(h, rgb_buffer(synthetic_frame(64, 48, i), i * GST_SECOND / 30)), GST_FLOW_OK);
   gst_harness_set_src_caps_str(h, caps_for(96, 64).c_str());
-  for (int i = 2; i < 4; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(synthetic_frame(96, 64, i), i * GST_SECOND / 30)), GST_FLOW_OK);
+  for (int i = 2; i < 4; ++i)
+    ASSERT_EQ(gst_harness_push(h, rgb_buffer(synthetic_frame(96, 64, i), i * GST_SECOND / 30)), GST_FLOW_OK);
   std::vector<NeuflowFlowMeta*> metas;
   std::vector<GstBuffer*> out;
   for (int i = 0; i < 4; ++i) {
@@ -133,7 +137,8 @@ TEST_F(NeuflowElement, SizeChangeAndFlushStartANewStreamOfFlows) {
   GstSegment segment;
   gst_segment_init(&segment, GST_FORMAT_TIME);
   ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_segment(&segment)));
-  for (int i = 4; i < 6; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(synthetic_frame(96, 64, i), i * GST_SECOND / 30)), GST_FLOW_OK);
+  for (int i = 4; i < 6; ++i)
+    ASSERT_EQ(gst_harness_push(h, rgb_buffer(synthetic_frame(96, 64, i), i * GST_SECOND / 30)), GST_FLOW_OK);
   GstBuffer* a = gst_harness_pull(h);
   GstBuffer* b = gst_harness_pull(h);
   ASSERT_TRUE(a && b);
@@ -150,7 +155,8 @@ TEST_F(NeuflowElement, SizeChangeAndFlushStartANewStreamOfFlows) {
 GstMessageType run_to_end(GstElement* pipeline, GstClockTime timeout, std::string* error = nullptr) {
   EXPECT_NE(gst_element_set_state(pipeline, GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
   GstBus* bus = gst_element_get_bus(pipeline);
-  GstMessage* msg = gst_bus_timed_pop_filtered(bus, timeout, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+  GstMessage* msg =
+      gst_bus_timed_pop_filtered(bus, timeout, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
   GstMessageType type = msg ? GST_MESSAGE_TYPE(msg) : GST_MESSAGE_UNKNOWN;
   if (msg && type == GST_MESSAGE_ERROR && error) {
     GError* err = nullptr;
@@ -194,7 +200,8 @@ GstElement* pipeline_with_counter(const std::string& description, Counter* count
 TEST_F(NeuflowElement, EveryPairModeOnAFileComputesEveryPairAndDrainsAtEos) {
   Counter counter;
   GstElement* pipeline = pipeline_with_counter(
-      "videotestsrc num-buffers=12 pattern=ball ! video/x-raw,width=64,height=48 ! neuflow name=nf iters-s8=2 threads=2 model=" +
+      "videotestsrc num-buffers=12 pattern=ball ! video/x-raw,width=64,height=48 ! neuflow name=nf iters-s8=2 "
+      "threads=2 model=" +
           model_ + " ! fakesink sync=false",
       &counter);
   EXPECT_EQ(run_to_end(pipeline, 120 * GST_SECOND), GST_MESSAGE_EOS);
@@ -215,7 +222,8 @@ TEST_F(NeuflowElement, LiveSourceFasterThanInferenceDropsAndKeepsOrder) {
   // 120 fps of 320×240 against inference that takes tens of milliseconds per frame.
   GstElement* pipeline = pipeline_with_counter(
       "videotestsrc is-live=true num-buffers=120 pattern=ball ! video/x-raw,width=320,height=240,framerate=120/1 ! "
-      "neuflow name=nf threads=2 model=" + model_ + " ! fakesink sync=false",
+      "neuflow name=nf threads=2 model=" +
+          model_ + " ! fakesink sync=false",
       &counter);
   EXPECT_EQ(run_to_end(pipeline, 120 * GST_SECOND), GST_MESSAGE_EOS);
   GstElement* nf = gst_bin_get_by_name(GST_BIN(pipeline), "nf");
@@ -250,7 +258,8 @@ TEST_F(NeuflowElement, LiveRunStaysBoundedInLatencyAndMemory) {
   GError* err = nullptr;
   GstElement* pipeline = gst_parse_launch(
       ("videotestsrc is-live=true pattern=ball ! video/x-raw,width=160,height=120,framerate=60/1 ! neuflow name=nf "
-       "threads=2 iters-s8=4 model=" + model_ + " ! videoscale ! video/x-raw,width=320,height=240 ! fakesink name=sink sync=true")
+       "threads=2 iters-s8=4 model=" +
+       model_ + " ! videoscale ! video/x-raw,width=320,height=240 ! fakesink name=sink sync=true")
           .c_str(),
       &err);
   ASSERT_EQ(err, nullptr);
@@ -329,7 +338,8 @@ TEST_F(NeuflowElement, WithoutAQueueALivePipelineKeepsTheRateOfOneWithAQueue) {
     GError* err = nullptr;
     GstElement* pipeline = gst_parse_launch(
         ("videotestsrc is-live=true pattern=ball ! video/x-raw,width=320,height=256,framerate=30/1 ! neuflow name=nf "
-         "threads=2 model=" + model_ + (with_queue ? " ! queue" : "") + " ! fakesink sync=true")
+         "threads=2 model=" +
+         model_ + (with_queue ? " ! queue" : "") + " ! fakesink sync=true")
             .c_str(),
         &err);
     EXPECT_EQ(err, nullptr);
@@ -366,7 +376,8 @@ TEST_F(NeuflowElement, SurvivesManyStateCycles) {
   GError* err = nullptr;
   GstElement* pipeline = gst_parse_launch(
       ("videotestsrc is-live=true pattern=ball ! video/x-raw,width=64,height=48,framerate=60/1 ! neuflow iters-s8=1 "
-       "threads=2 model=" + model_ + " ! fakesink")
+       "threads=2 model=" +
+       model_ + " ! fakesink")
           .c_str(),
       &err);
   ASSERT_EQ(err, nullptr);
@@ -418,8 +429,8 @@ TEST_F(NeuflowElement, VulkanBackendWritesTheSameFlowsAsTheCpu) {
   GstElement* pipeline = gst_parse_launch(
       ("multifilesrc location=" + (dir / "frame%d.png").string() +
        " index=0 stop-index=2 caps=image/png,framerate=10/1 ! pngdec ! videoconvert ! neuflow name=nf backend=vulkan "
-       "device=0 iters-s8=2 behaviour=every-pair model=" + model_ + " ! neuflowsink location=" +
-       (dir / "flow" / "%05d.flo").string())
+       "device=0 iters-s8=2 behaviour=every-pair model=" +
+       model_ + " ! neuflowsink location=" + (dir / "flow" / "%05d.flo").string())
           .c_str(),
       &err);
   ASSERT_EQ(err, nullptr) << err->message;
@@ -438,14 +449,16 @@ TEST_F(NeuflowElement, VulkanBackendWritesTheSameFlowsAsTheCpu) {
                                   {.iterations = {1, 2}, .threads = 2, .backend = neuflow::model::Backend::cpu});
   int compared = 0;
   for (int i = 0; i < 3; ++i) {
-    const auto expected = cpu.push(neuflow::model::ImageView{frames[i].data, 64, 48, 64 * 3, neuflow::model::ChannelOrder::rgb});
+    const auto expected =
+        cpu.push(neuflow::model::ImageView{frames[i].data, 64, 48, 64 * 3, neuflow::model::ChannelOrder::rgb});
     if (!expected) continue;
     char name[32];  // neuflowsink numbers the flows it writes from 0
     std::snprintf(name, sizeof name, "%05d.flo", compared);
     const auto got = neuflow::flow::read_flow(dir / "flow" / name);
     ASSERT_EQ(got.uv.size(), expected->uv.size()) << name;
     double max_err = 0;
-    for (std::size_t k = 0; k < got.uv.size(); ++k) max_err = std::max(max_err, static_cast<double>(std::fabs(got.uv[k] - expected->uv[k])));
+    for (std::size_t k = 0; k < got.uv.size(); ++k)
+      max_err = std::max(max_err, static_cast<double>(std::fabs(got.uv[k] - expected->uv[k])));
     EXPECT_LT(max_err, 1e-2) << name;
     ++compared;
   }
@@ -514,7 +527,8 @@ TEST_F(NeuflowElement, VulkanFramesInFlightArriveInOrderWithTheirPairs) {
   GstSegment segment;
   gst_segment_init(&segment, GST_FORMAT_TIME);
   ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_segment(&segment)));
-  for (int i = 0; i < 2; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (100 + i) * GST_SECOND)), GST_FLOW_OK);
+  for (int i = 0; i < 2; ++i)
+    ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (100 + i) * GST_SECOND)), GST_FLOW_OK);
   std::vector<GstBuffer*> after;
   while (after.size() < 2) {
     GstBuffer* out = gst_harness_pull(h);
@@ -531,7 +545,8 @@ TEST_F(NeuflowElement, VulkanFramesInFlightArriveInOrderWithTheirPairs) {
   EXPECT_EQ(meta->from_pts, 100 * GST_SECOND);
   for (GstBuffer* b : after) gst_buffer_unref(b);
 
-  for (int i = 0; i < 3; ++i) ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (200 + i) * GST_SECOND)), GST_FLOW_OK);
+  for (int i = 0; i < 3; ++i)
+    ASSERT_EQ(gst_harness_push(h, rgb_buffer(frames[i], (200 + i) * GST_SECOND)), GST_FLOW_OK);
   gst_harness_teardown(h);  // with frames queued and in flight
   gst_debug_remove_log_function(count_in_flight);
   gst_debug_unset_threshold_for_name("neuflow");

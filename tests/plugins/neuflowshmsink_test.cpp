@@ -21,8 +21,8 @@
 #include <thread>
 #include <vector>
 
-#include "neuflow/flow/flow_io.hpp"
 #include "flow_ring_writer.hpp"
+#include "neuflow/flow/flow_io.hpp"
 #include "neuflow/flow_ring.hpp"
 #include "sink_test_util.hpp"
 
@@ -245,7 +245,8 @@ TEST_P(NeuflowShmSinkBadNames, FailAtStartNamingTheNameAndWhatIsExpected) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Names, NeuflowShmSinkBadNames,
-                         ::testing::Values("neuflow-front", "/", "/a/b", "/neuflow/", "/..", std::string("/") + std::string(300, 'x')));
+                         ::testing::Values("neuflow-front", "/", "/a/b", "/neuflow/", "/..",
+                                           std::string("/") + std::string(300, 'x')));
 
 TEST(NeuflowShmSink, MissingNameFailsAtStartSayingWhatToSet) {
   const ErrorMessage error = start_error("neuflowshmsink", {});
@@ -510,8 +511,8 @@ TEST(NeuflowShmSinkPythonReader, ReadsTheNewestFlowExactly) {
 // units give the segment the fixed group `neuflow` (Group=neuflow), which readers join.
 class FlowRingAsAnotherUser : public ::testing::Test {
  protected:
-  static constexpr uid_t kReaderUid = 65534;   // nobody
-  static constexpr gid_t kRingGroup = 64000;   // stands for the `neuflow` group
+  static constexpr uid_t kReaderUid = 65534;  // nobody
+  static constexpr gid_t kRingGroup = 64000;  // stands for the `neuflow` group
   static constexpr gid_t kOtherGroup = 64001;
 
   void SetUp() override {

@@ -64,8 +64,8 @@ TEST(NeuflowSinkRetention, MaxFilesKeepsTheNewestFilesAndTheIndexListsExactlyThe
     ASSERT_EQ(s.push(buffer_with_flow(nth_flow(n))), GST_FLOW_OK);
     EXPECT_LE(dir.entries().size(), 5u + 1u) << "after flow " << n;
   }
-  const std::vector<std::string> newest = {flow_name(15), flow_name(16), flow_name(17), flow_name(18),
-                                           flow_name(19), "index.csv"};
+  const std::vector<std::string> newest = {flow_name(15), flow_name(16), flow_name(17),
+                                           flow_name(18), flow_name(19), "index.csv"};
   EXPECT_EQ(dir.entries(), newest);
   // While running the index may still hold rows of deleted files (at most twice the live
   // ones, at least 32), but always every file on disk.
@@ -96,8 +96,8 @@ TEST(NeuflowSinkRetention, MaxBytesKeepsTheNewestFilesThatFitAndCanBeSetWhilePla
   EXPECT_EQ(dir.entries(),
             (std::vector<std::string>{flow_name(0), flow_name(9), flow_name(10), flow_name(11), "index.csv"}));
   s.stop();
-  EXPECT_EQ(read_lines(dir.path() / "index.csv"),
-            (std::vector<std::string>{kHeader, index_row(0, 0), index_row(9, 9), index_row(10, 10), index_row(11, 11)}));
+  EXPECT_EQ(read_lines(dir.path() / "index.csv"), (std::vector<std::string>{kHeader, index_row(0, 0), index_row(9, 9),
+                                                                            index_row(10, 10), index_row(11, 11)}));
 }
 
 TEST(NeuflowSinkRetention, NewestFileIsKeptEvenWhenLargerThanMaxBytes) {
@@ -188,9 +188,9 @@ std::string unwritable_directory(const TempDir &dir) {
 TEST(NeuflowSinkRetention, UnwritableDirectoryPostsTheErrorBeforeReturningTheFlowError) {
   TempDir dir;
   const std::string target = unwritable_directory(dir);
-  auto s = start_sink("neuflowsink", {{"location", target + "/flow_%03d.flo"},
-                                      {"index-location", (dir / "index.csv").string()},
-                                      {"max-files", "2"}});
+  auto s = start_sink(
+      "neuflowsink",
+      {{"location", target + "/flow_%03d.flo"}, {"index-location", (dir / "index.csv").string()}, {"max-files", "2"}});
   ASSERT_TRUE(s.harness);
   EXPECT_EQ(s.push(buffer_with_flow(nth_flow(0))), GST_FLOW_ERROR);
   // Synchronously on the bus by the time the flow error comes back: an application (the
@@ -251,13 +251,13 @@ TEST(NeuflowSinkRetention, TemporariesOfInterruptedWritesAreRemovedAtStart) {
 
 TEST(EarlierFiles, TheNamesAPatternMakesAreFoundInIndexOrder) {
   TempDir dir;
-  for (const char* name : {"f_10.flo", "f_9.flo", "f_0100.flo", "f_x.flo", "g_1.flo", "f_2.npy", "f_-3.flo"}) {
+  for (const char *name : {"f_10.flo", "f_9.flo", "f_0100.flo", "f_x.flo", "g_1.flo", "f_2.npy", "f_-3.flo"}) {
     std::ofstream(dir / name) << name;
   }
   std::filesystem::create_directory(dir / "f_5.flo");
   const auto found = gst::files_matching((dir / "f_%d.flo").string());
   std::vector<std::int64_t> indices;
-  for (const auto& f : found) indices.push_back(f.index);
+  for (const auto &f : found) indices.push_back(f.index);
   EXPECT_EQ(indices, (std::vector<std::int64_t>{-3, 9, 10, 100}));
   EXPECT_EQ(found[1].bytes, 7u);
   const auto hex = gst::files_matching((dir / "f_%x.flo").string());

@@ -113,7 +113,7 @@ TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
   auto s = start_sink({{"location", (dir / "flow_%03d.flo").string()}, {"index", "5"}});
   ASSERT_TRUE(s.harness);
   const FlowSpec first{8, 6, 0, 1, 0, 33333333, 0.5f};
-  const FlowSpec second{8, 6, 1, 3, 33333333, 100000000, 1.25f};  // frame 2 was dropped upstream
+  const FlowSpec second{8, 6, 1, 3, 33333333, 100000000, 1.25f};           // frame 2 was dropped upstream
   const FlowSpec third{4, 3, 3, 4, GST_CLOCK_TIME_NONE, 133333333, -2.f};  // unknown start time
 
   EXPECT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow(first)), GST_FLOW_OK);
@@ -124,8 +124,7 @@ TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
   expect_flow_file(dir.path() / "flow_005.flo", first);
   expect_flow_file(dir.path() / "flow_006.flo", second);
   expect_flow_file(dir.path() / "flow_007.flo", third);
-  EXPECT_EQ(dir.entries(),
-            (std::vector<std::string>{"flow_005.flo", "flow_006.flo", "flow_007.flo", "index.csv"}));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"flow_005.flo", "flow_006.flo", "flow_007.flo", "index.csv"}));
 
   EXPECT_EQ(read_lines(dir.path() / "index.csv"),
             (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source",
@@ -133,9 +132,9 @@ TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
                                       "7,3,4,,133333333,flow_007.flo,,"}));
 
   EXPECT_EQ(uint64_property(s.element.get(), "flows-written"), 3u);
-  EXPECT_EQ(uint64_property(s.element.get(), "bytes-written"),
-            fs::file_size(dir.path() / "flow_005.flo") + fs::file_size(dir.path() / "flow_006.flo") +
-                fs::file_size(dir.path() / "flow_007.flo"));
+  EXPECT_EQ(uint64_property(s.element.get(), "bytes-written"), fs::file_size(dir.path() / "flow_005.flo") +
+                                                                   fs::file_size(dir.path() / "flow_006.flo") +
+                                                                   fs::file_size(dir.path() / "flow_007.flo"));
   EXPECT_EQ(uint64_property(s.element.get(), "buffers-skipped"), 1u);
   gint index = 0;
   g_object_get(s.element.get(), "index", &index, nullptr);
@@ -161,9 +160,15 @@ TEST_P(NeuflowSinkFormats, FormatFollowsTheExtension) {
   char magic[8] = {};
   in.read(magic, sizeof magic);
   switch (*format) {
-    case flow::FlowFormat::flo: EXPECT_EQ(std::string(magic, 4), "PIEH"); break;
-    case flow::FlowFormat::npy: EXPECT_EQ(std::string(magic + 1, 5), "NUMPY"); break;
-    case flow::FlowFormat::kitti_png: EXPECT_EQ(std::string(magic + 1, 3), "PNG"); break;
+    case flow::FlowFormat::flo:
+      EXPECT_EQ(std::string(magic, 4), "PIEH");
+      break;
+    case flow::FlowFormat::npy:
+      EXPECT_EQ(std::string(magic + 1, 5), "NUMPY");
+      break;
+    case flow::FlowFormat::kitti_png:
+      EXPECT_EQ(std::string(magic + 1, 3), "PNG");
+      break;
   }
 }
 
@@ -182,9 +187,10 @@ TEST(NeuflowSink, IndexIsAppendedAcrossRestartsWithOneHeader) {
     ASSERT_TRUE(s.harness);
     ASSERT_EQ(gst_harness_push(s.harness.get(), buffer_with_flow({4, 4, 0, 1, 30, 40, 0.f})), GST_FLOW_OK);
   }
-  EXPECT_EQ(read_lines(dir.path() / "index.csv"),
-            (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source",
-                                      "0,0,1,0,10,flow_0.flo,,", "1,1,2,10,20,flow_1.flo,,", "2,0,1,30,40,flow_2.flo,,"}));
+  EXPECT_EQ(
+      read_lines(dir.path() / "index.csv"),
+      (std::vector<std::string>{"index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source",
+                                "0,0,1,0,10,flow_0.flo,,", "1,1,2,10,20,flow_1.flo,,", "2,0,1,30,40,flow_2.flo,,"}));
 }
 
 TEST(NeuflowSink, IndexElsewhereNamesTheFilesAsWritten) {
@@ -301,8 +307,10 @@ TEST(NeuflowSink, UnwritableIndexStopsWithAnErrorNamingIt) {
 
 TEST(NeuflowSink, PipelineWithoutFlowReachesEosWritingNothing) {
   TempDir dir;
-  const std::string launch = "videotestsrc num-buffers=7 ! video/x-raw,width=64,height=48 ! neuflowsink name=sink "
-                             "location=\"" + (dir / "flow_%05d.flo").string() + "\"";
+  const std::string launch =
+      "videotestsrc num-buffers=7 ! video/x-raw,width=64,height=48 ! neuflowsink name=sink "
+      "location=\"" +
+      (dir / "flow_%05d.flo").string() + "\"";
   ElementPtr pipeline = owned(gst_parse_launch(launch.c_str(), nullptr));
   ASSERT_TRUE(pipeline);
   ASSERT_NE(gst_element_set_state(pipeline.get(), GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);

@@ -30,7 +30,11 @@ GstBuffer *frame_with_uniform_flow(GstVideoFormat format, int width, int height,
                                    int grid_height, float u, float v) {
   GstBuffer *buffer = make_frame(format, width, height, fill);
   add_flow(buffer, grid_width, grid_height,
-           make_vectors(grid_width, grid_height, [&](int, int) { return std::pair{u, v}; }), width, height);
+           make_vectors(grid_width, grid_height,
+                        [&](int, int) {
+                          return std::pair{u, v};
+                        }),
+           width, height);
   return buffer;
 }
 
@@ -73,7 +77,7 @@ TEST(NeuflowViz, PropertiesHaveTheirDocumentedDefaults) {
   EXPECT_EQ(spacing, 24u);
   EXPECT_EQ(color, 0xff000000u);
   EXPECT_EQ(scale, 0.0);  // automatic
-  EXPECT_EQ(mode, 0);  // overlay: what the README's live view expects
+  EXPECT_EQ(mode, 0);     // overlay: what the README's live view expects
   gst_util_set_object_arg(G_OBJECT(viz.get()), "mode", "flow");
   g_object_get(viz.get(), "mode", &mode, nullptr);
   EXPECT_EQ(mode, 1);
@@ -82,8 +86,8 @@ TEST(NeuflowViz, PropertiesHaveTheirDocumentedDefaults) {
 TEST(NeuflowViz, ZeroFlowIsWhiteInFlowMode) {
   constexpr int w = 16, h = 12;
   auto harness = make_viz(GST_VIDEO_FORMAT_RGBA, w, h);
-  BufferPtr out(gst_harness_push_and_pull(harness.get(),
-                                          frame_with_uniform_flow(GST_VIDEO_FORMAT_RGBA, w, h, 77, w, h, 0, 0)));
+  BufferPtr out(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGBA, w, h, 77, w, h, 0, 0)));
   ASSERT_TRUE(out);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -117,20 +121,20 @@ TEST_P(NeuflowVizFormats, RightwardFlowAtMaxFlowIsTheWheelColourForAngleZero) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    PackedRgb, NeuflowVizFormats,
-    ::testing::Values(FormatCase{GST_VIDEO_FORMAT_RGB, {255, 0, 0}}, FormatCase{GST_VIDEO_FORMAT_BGR, {0, 0, 255}},
-                      FormatCase{GST_VIDEO_FORMAT_RGBA, {255, 0, 0, 77}},
-                      FormatCase{GST_VIDEO_FORMAT_BGRA, {0, 0, 255, 77}},
-                      FormatCase{GST_VIDEO_FORMAT_RGBx, {255, 0, 0, 77}},
-                      FormatCase{GST_VIDEO_FORMAT_BGRx, {0, 0, 255, 77}},
-                      FormatCase{GST_VIDEO_FORMAT_ARGB, {77, 255, 0, 0}},
-                      FormatCase{GST_VIDEO_FORMAT_ABGR, {77, 0, 0, 255}},
-                      FormatCase{GST_VIDEO_FORMAT_xRGB, {77, 255, 0, 0}},
-                      FormatCase{GST_VIDEO_FORMAT_xBGR, {77, 0, 0, 255}}),
-    [](const ::testing::TestParamInfo<FormatCase> &param) {
-      return std::string(gst_video_format_to_string(param.param.format));
-    });
+INSTANTIATE_TEST_SUITE_P(PackedRgb, NeuflowVizFormats,
+                         ::testing::Values(FormatCase{GST_VIDEO_FORMAT_RGB, {255, 0, 0}},
+                                           FormatCase{GST_VIDEO_FORMAT_BGR, {0, 0, 255}},
+                                           FormatCase{GST_VIDEO_FORMAT_RGBA, {255, 0, 0, 77}},
+                                           FormatCase{GST_VIDEO_FORMAT_BGRA, {0, 0, 255, 77}},
+                                           FormatCase{GST_VIDEO_FORMAT_RGBx, {255, 0, 0, 77}},
+                                           FormatCase{GST_VIDEO_FORMAT_BGRx, {0, 0, 255, 77}},
+                                           FormatCase{GST_VIDEO_FORMAT_ARGB, {77, 255, 0, 0}},
+                                           FormatCase{GST_VIDEO_FORMAT_ABGR, {77, 0, 0, 255}},
+                                           FormatCase{GST_VIDEO_FORMAT_xRGB, {77, 255, 0, 0}},
+                                           FormatCase{GST_VIDEO_FORMAT_xBGR, {77, 0, 0, 255}}),
+                         [](const ::testing::TestParamInfo<FormatCase> &param) {
+                           return std::string(gst_video_format_to_string(param.param.format));
+                         });
 
 TEST(NeuflowViz, OtherDirectionsGetTheirWheelColours) {
   constexpr int w = 4, h = 4;
@@ -161,8 +165,8 @@ TEST(NeuflowViz, FrameWithoutFlowPassesThroughUnchangedAndUncopiedInOverlayMode)
       }
     }
     // The next frame has flow again and is drawn.
-    BufferPtr drawn(gst_harness_push_and_pull(harness.get(),
-                                              frame_with_uniform_flow(GST_VIDEO_FORMAT_BGRx, w, h, 77, w, h, 0, 0)));
+    BufferPtr drawn(
+        gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_BGRx, w, h, 77, w, h, 0, 0)));
     ASSERT_TRUE(drawn);
     EXPECT_NE(pixel_bytes(drawn.get(), GST_VIDEO_FORMAT_BGRx, w, h, 3, 3), (std::vector<std::uint8_t>(4, 77)));
   }
@@ -179,7 +183,8 @@ TEST(NeuflowViz, FrameWithoutFlowIsZeroFlowWhiteInFlowMode) {
   ASSERT_TRUE(out);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      ASSERT_EQ(pixel_bytes(out.get(), GST_VIDEO_FORMAT_RGBA, w, h, x, y), (std::vector<std::uint8_t>{255, 255, 255, 77}));
+      ASSERT_EQ(pixel_bytes(out.get(), GST_VIDEO_FORMAT_RGBA, w, h, x, y),
+                (std::vector<std::uint8_t>{255, 255, 255, 77}));
       ASSERT_EQ(pixel_bytes(keep.get(), GST_VIDEO_FORMAT_RGBA, w, h, x, y), (std::vector<std::uint8_t>(4, 77)));
     }
   }
@@ -202,8 +207,8 @@ TEST(NeuflowViz, SmallerGridIsStretchedOverTheFrameWithVectorsInFramePixels) {
 
   // Vertically: 3 grid pixels over 12 frame rows are 12 frame pixels.
   g_object_set(harness->element, "max-flow", 12.0, nullptr);
-  BufferPtr down(gst_harness_push_and_pull(harness.get(),
-                                           frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, gw, gh, 0, 3)));
+  BufferPtr down(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 0, gw, gh, 0, 3)));
   ASSERT_TRUE(down);
   expect_uniform(down.get(), w, h, flow_color(0, 1));
 }
@@ -215,8 +220,8 @@ TEST(NeuflowViz, OverlayBlendsTheFlowColoursOverTheVideoWithAlpha) {
   const std::pair<double, int> cases[] = {{0.5, 178}, {0.0, 100}, {1.0, 255}};  // white over grey 100
   for (const auto &[alpha, expected] : cases) {
     g_object_set(harness->element, "alpha", alpha, nullptr);
-    BufferPtr out(gst_harness_push_and_pull(harness.get(),
-                                            frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 100, w, h, 0, 0)));
+    BufferPtr out(
+        gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_RGB, w, h, 100, w, h, 0, 0)));
     ASSERT_TRUE(out);
     SCOPED_TRACE("alpha " + std::to_string(alpha));
     const auto e = static_cast<std::uint8_t>(expected);
@@ -265,7 +270,8 @@ TEST(NeuflowViz, ArrowsStartAtTheGridPointsAndShowTheScaledDisplacement) {
   // (8, 24), (24, 24) and run 6 px right; the anti-aliased shaft covers its pixels.
   for (int ay : {8, 24}) {
     for (int ax : {8, 24}) {
-      for (int x = ax; x <= ax + 6; ++x) EXPECT_GT(darkening(out.get(), w, h, x, ay, background), 100) << x << "," << ay;
+      for (int x = ax; x <= ax + 6; ++x)
+        EXPECT_GT(darkening(out.get(), w, h, x, ay, background), 100) << x << "," << ay;
       EXPECT_EQ(darkening(out.get(), w, h, ax - 2, ay, background), 0);  // nothing behind the start
       if (ax + 8 < w) {
         EXPECT_EQ(darkening(out.get(), w, h, ax + 8, ay, background), 0);  // nothing past the tip
@@ -302,7 +308,11 @@ TEST(NeuflowViz, ArrowsStartAtTheGridPointsAndShowTheScaledDisplacement) {
   // compared with the same frame drawn without arrows, nothing changes past the next anchor.
   const auto one_huge_vector = [] {
     GstBuffer *in = make_frame(GST_VIDEO_FORMAT_RGB, 48, 16, 0);
-    add_flow(in, 3, 1, make_vectors(3, 1, [](int x, int) { return x == 0 ? std::pair{100.f, 0.f} : std::pair{0.f, 0.f}; }),
+    add_flow(in, 3, 1,
+             make_vectors(3, 1,
+                          [](int x, int) {
+                            return x == 0 ? std::pair{100.f, 0.f} : std::pair{0.f, 0.f};
+                          }),
              48, 16);
     return in;
   };
@@ -311,10 +321,12 @@ TEST(NeuflowViz, ArrowsStartAtTheGridPointsAndShowTheScaledDisplacement) {
   g_object_set(wide->element, "arrows", TRUE, "arrow-spacing", 16u, nullptr);
   BufferPtr with_arrow(gst_harness_push_and_pull(wide.get(), one_huge_vector()));
   ASSERT_TRUE(plain && with_arrow);
-  EXPECT_NE(rgb_at(with_arrow.get(), GST_VIDEO_FORMAT_RGB, 48, 16, 20, 8), rgb_at(plain.get(), GST_VIDEO_FORMAT_RGB, 48, 16, 20, 8));
+  EXPECT_NE(rgb_at(with_arrow.get(), GST_VIDEO_FORMAT_RGB, 48, 16, 20, 8),
+            rgb_at(plain.get(), GST_VIDEO_FORMAT_RGB, 48, 16, 20, 8));
   for (int x = 28; x < 48; ++x) {
     if (x == 40) continue;  // the third cell's anchor
-    EXPECT_EQ(rgb_at(with_arrow.get(), GST_VIDEO_FORMAT_RGB, 48, 16, x, 8), rgb_at(plain.get(), GST_VIDEO_FORMAT_RGB, 48, 16, x, 8))
+    EXPECT_EQ(rgb_at(with_arrow.get(), GST_VIDEO_FORMAT_RGB, 48, 16, x, 8),
+              rgb_at(plain.get(), GST_VIDEO_FORMAT_RGB, 48, 16, x, 8))
         << "x " << x;
   }
 
@@ -337,11 +349,14 @@ TEST(NeuflowViz, HugeAndNonFiniteVectorsAreClippedNotFatal) {
   auto harness = make_viz(GST_VIDEO_FORMAT_RGBx, w, h);
   g_object_set(harness->element, "arrows", TRUE, "arrow-spacing", 4u, nullptr);
   GstBuffer *in = make_frame(GST_VIDEO_FORMAT_RGBx, w, h, 0);
-  add_flow(in, 4, 3, make_vectors(4, 3, [](int x, int y) {
-             if (x == 0) return std::pair{1e9f, -1e9f};
-             if (x == 1) return std::pair{std::numeric_limits<float>::quiet_NaN(), 0.f};
-             return std::pair{-1e30f * static_cast<float>(y + 1), 3.f};
-           }), w, h);
+  add_flow(in, 4, 3,
+           make_vectors(4, 3,
+                        [](int x, int y) {
+                          if (x == 0) return std::pair{1e9f, -1e9f};
+                          if (x == 1) return std::pair{std::numeric_limits<float>::quiet_NaN(), 0.f};
+                          return std::pair{-1e30f * static_cast<float>(y + 1), 3.f};
+                        }),
+           w, h);
   BufferPtr out(gst_harness_push_and_pull(harness.get(), in));
   ASSERT_TRUE(out);
 }
@@ -349,10 +364,10 @@ TEST(NeuflowViz, HugeAndNonFiniteVectorsAreClippedNotFatal) {
 // The pipeline people will write: negotiation through videoconvert on both sides, and the
 // flow meta surviving a conversion in front of the visualizer.
 TEST(NeuflowViz, NegotiatesThroughVideoconvert) {
-  ElementPtr pipeline = owned(gst_parse_launch(
-      "videotestsrc num-buffers=5 ! video/x-raw,format=I420,width=64,height=48 ! videoconvert ! "
-      "neuflowviz arrows=true ! videoconvert ! fakesink",
-      nullptr));
+  ElementPtr pipeline =
+      owned(gst_parse_launch("videotestsrc num-buffers=5 ! video/x-raw,format=I420,width=64,height=48 ! videoconvert ! "
+                             "neuflowviz arrows=true ! videoconvert ! fakesink",
+                             nullptr));
   ASSERT_TRUE(pipeline);
   ASSERT_NE(gst_element_set_state(pipeline.get(), GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
   BusPtr bus(gst_element_get_bus(pipeline.get()));
@@ -367,8 +382,8 @@ TEST(NeuflowViz, FlowMetaSurvivesVideoconvertInFront) {
   constexpr int w = 8, h = 6;
   HarnessPtr harness(gst_harness_new_parse("videoconvert ! video/x-raw,format=RGBA ! neuflowviz mode=flow"));
   gst_harness_set_src_caps_str(harness.get(), caps_string(GST_VIDEO_FORMAT_I420, w, h).c_str());
-  BufferPtr out(gst_harness_push_and_pull(harness.get(),
-                                          frame_with_uniform_flow(GST_VIDEO_FORMAT_I420, w, h, 128, w, h, 20, 0)));
+  BufferPtr out(
+      gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(GST_VIDEO_FORMAT_I420, w, h, 128, w, h, 20, 0)));
   ASSERT_TRUE(out);
   EXPECT_EQ(pixel_bytes(out.get(), GST_VIDEO_FORMAT_RGBA, w, h, 2, 2), (std::vector<std::uint8_t>{255, 0, 0, 255}));
 }

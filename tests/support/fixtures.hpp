@@ -1,7 +1,7 @@
 #pragma once
 // Locating ../shared/fixtures for tests, and skipping (or, under CI, failing) when absent.
-#include <filesystem>
 #include <gtest/gtest.h>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -21,15 +21,15 @@ std::string missing_fixtures_message(const std::string& what);
 
 // Resolves `var` to fixtures_dir()/relative, or skips the test (fails it under CI) when the
 // file or folder is absent.
-#define NEUFLOW_REQUIRE_FIXTURE(var, relative)                                              \
-  std::filesystem::path var;                                                                 \
-  do {                                                                                       \
-    auto neuflow_dir_ = ::neuflow::test::fixtures_dir();                                     \
-    if (neuflow_dir_ && std::filesystem::exists(*neuflow_dir_ / (relative))) {              \
-      var = *neuflow_dir_ / (relative);                                                      \
-    } else if (::neuflow::test::fixtures_required()) {                                       \
-      FAIL() << ::neuflow::test::missing_fixtures_message(relative);                         \
-    } else {                                                                                 \
-      GTEST_SKIP() << ::neuflow::test::missing_fixtures_message(relative);                   \
-    }                                                                                        \
+#define NEUFLOW_REQUIRE_FIXTURE(var, relative)                                 \
+  std::filesystem::path var;                                                   \
+  do {                                                                         \
+    auto neuflow_dir_ = ::neuflow::test::fixtures_dir();                       \
+    if (neuflow_dir_ && std::filesystem::exists(*neuflow_dir_ / (relative))) { \
+      var = *neuflow_dir_ / (relative);                                        \
+    } else if (::neuflow::test::fixtures_required()) {                         \
+      FAIL() << ::neuflow::test::missing_fixtures_message(relative);           \
+    } else {                                                                   \
+      GTEST_SKIP() << ::neuflow::test::missing_fixtures_message(relative);     \
+    }                                                                          \
   } while (0)

@@ -55,17 +55,17 @@ inline bool only_software_vulkan() {
 
 }  // namespace neuflow::test
 
-#define NEUFLOW_REQUIRE_VULKAN()                                                                   \
-  do {                                                                                            \
-    const std::string neuflow_deadlock_ = ::neuflow::test::vulkan_deadlocks_under_lsan();         \
-    if (!neuflow_deadlock_.empty()) FAIL() << neuflow_deadlock_;                                  \
-    const std::string neuflow_missing_ = ::neuflow::test::vulkan_missing();                       \
-    if (!neuflow_missing_.empty()) {                                                              \
-      if (::neuflow::test::vulkan_required()) FAIL() << neuflow_missing_;                         \
-      GTEST_SKIP() << neuflow_missing_ << " (NEUFLOW_REQUIRE_VULKAN=1 makes this a failure)";     \
-    }                                                                                             \
+#define NEUFLOW_REQUIRE_VULKAN()                                                              \
+  do {                                                                                        \
+    const std::string neuflow_deadlock_ = ::neuflow::test::vulkan_deadlocks_under_lsan();     \
+    if (!neuflow_deadlock_.empty()) FAIL() << neuflow_deadlock_;                              \
+    const std::string neuflow_missing_ = ::neuflow::test::vulkan_missing();                   \
+    if (!neuflow_missing_.empty()) {                                                          \
+      if (::neuflow::test::vulkan_required()) FAIL() << neuflow_missing_;                     \
+      GTEST_SKIP() << neuflow_missing_ << " (NEUFLOW_REQUIRE_VULKAN=1 makes this a failure)"; \
+    }                                                                                         \
   } while (0)
 
-#define NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES()                                                    \
-  EXPECT_EQ(::neuflow::model::vulkan_validation_message_count(), 0u)                               \
+#define NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES()                      \
+  EXPECT_EQ(::neuflow::model::vulkan_validation_message_count(), 0u) \
       << "the Vulkan validation layer reported problems (printed above)"

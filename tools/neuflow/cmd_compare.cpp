@@ -57,20 +57,18 @@ void print_json(const flow::FlowMetrics& m) {
   std::printf(
       "{\"epe\": %s, \"fl_all\": %s, \"within_1px\": %s, \"within_3px\": %s, "
       "\"within_5px\": %s, \"valid_pixels\": %zu, \"total_pixels\": %zu}\n",
-      json_number(m.epe).c_str(), json_number(m.fl_all).c_str(),
-      json_number(m.within_1px).c_str(), json_number(m.within_3px).c_str(),
-      json_number(m.within_5px).c_str(), m.valid_pixels, m.total_pixels);
+      json_number(m.epe).c_str(), json_number(m.fl_all).c_str(), json_number(m.within_1px).c_str(),
+      json_number(m.within_3px).c_str(), json_number(m.within_5px).c_str(), m.valid_pixels, m.total_pixels);
 }
 
 void run_compare(const CompareOptions& options) {
   const flow::FlowField predicted = read(options.predicted);
   const flow::FlowField ground_truth = read(options.ground_truth);
   if (predicted.width != ground_truth.width || predicted.height != ground_truth.height) {
-    throw CommandError(kExitDataError,
-                       "compare: " + options.predicted + " is " + std::to_string(predicted.width) +
-                           "x" + std::to_string(predicted.height) + " but " +
-                           options.ground_truth + " is " + std::to_string(ground_truth.width) +
-                           "x" + std::to_string(ground_truth.height));
+    throw CommandError(kExitDataError, "compare: " + options.predicted + " is " + std::to_string(predicted.width) +
+                                           "x" + std::to_string(predicted.height) + " but " + options.ground_truth +
+                                           " is " + std::to_string(ground_truth.width) + "x" +
+                                           std::to_string(ground_truth.height));
   }
   flow::MetricsOptions metrics_options;
   metrics_options.use_predicted_mask = options.use_predicted_mask;
@@ -86,8 +84,8 @@ void run_compare(const CompareOptions& options) {
 
 void register_compare(CLI::App& app) {
   auto options = std::make_shared<CompareOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "compare", "Score a predicted flow file against ground truth (EPE, Fl-all, 1/3/5 px)");
+  CLI::App* cmd =
+      app.add_subcommand("compare", "Score a predicted flow file against ground truth (EPE, Fl-all, 1/3/5 px)");
   cmd->footer(
       "Pixels count where the ground truth is valid. Fl-all (KITTI): share of pixels whose "
       "error is > 3 px and > 5% of the true magnitude.\nExit status: 65 malformed input or "

@@ -1,7 +1,7 @@
 // neuflow convert: optical flow for every consecutive pair of frames of image pairs, folders
 // of frames and videos, written as flow files with an index, optionally rendered.
-#include <unistd.h>
 #include <sys/ioctl.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <memory>
@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "common/session_options.hpp"
 #include "convert/inputs.hpp"
 #include "convert/job.hpp"
 #include "convert/progress.hpp"
-#include "common/session_options.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -35,8 +35,8 @@ struct ConvertArgs {
   double max_flow = 20;
   bool resume = false;
   std::int64_t max_frames = 0;
-  std::string fps;    // --fps N or N/D
-  std::string shard;  // --shard K/N
+  std::string fps;     // --fps N or N/D
+  std::string shard;   // --shard K/N
   std::string frames;  // --frames A:B
 };
 
@@ -49,8 +49,10 @@ FrameRange parse_frames(const std::string& text) {
     return {first, std::nullopt};
   }
   if (n == 2 && first >= 0 && end > first) return {first, end};
-  throw CommandError(kExitUsage, "--frames wants A:B with 0 <= A < B (the pairs whose first frame is A to B-1, frames "
-                                 "counted from 0) or A: (to the end), got '" + text + "'");
+  throw CommandError(kExitUsage,
+                     "--frames wants A:B with 0 <= A < B (the pairs whose first frame is A to B-1, frames "
+                     "counted from 0) or A: (to the end), got '" +
+                         text + "'");
 }
 
 // "N" or "N/D" frames per second, positive.
@@ -61,7 +63,8 @@ pipeline::FrameRate parse_rate(const std::string& text) {
   if ((n == 1 || n == 2) && numerator > 0 && denominator > 0 && numerator <= 1000 * denominator) {
     return {numerator, denominator};
   }
-  throw CommandError(kExitUsage, "--fps wants frames per second as N or N/D (e.g. 15 or 30000/1001), got '" + text + "'");
+  throw CommandError(kExitUsage,
+                     "--fps wants frames per second as N or N/D (e.g. 15 or 30000/1001), got '" + text + "'");
 }
 
 struct Shard {
@@ -77,8 +80,10 @@ Shard parse_shard(const std::string& text) {
   if (std::sscanf(text.c_str(), "%ld/%ld%c", &k, &n, &rest) == 2 && n > 0 && k >= 0 && k < n) {
     return {static_cast<std::size_t>(k), static_cast<std::size_t>(n)};
   }
-  throw CommandError(kExitUsage, "--shard wants K/N with 0 <= K < N (this job's index from 0, and the number of "
-                                 "jobs), got '" + text + "'");
+  throw CommandError(kExitUsage,
+                     "--shard wants K/N with 0 <= K < N (this job's index from 0, and the number of "
+                     "jobs), got '" +
+                         text + "'");
 }
 
 int terminal_width(int fd) {
@@ -114,12 +119,14 @@ std::string summary_line(const InputSpec& input, const InputOutcome& outcome) {
 
 void run_convert(const ConvertArgs& a) {
   const model::SessionOptions options = session_options(a.session);
-  if (a.inputs.empty() && a.pairs.empty()) throw CommandError(kExitUsage, "nothing to convert: give INPUT... or --pair A B");
+  if (a.inputs.empty() && a.pairs.empty())
+    throw CommandError(kExitUsage, "nothing to convert: give INPUT... or --pair A B");
   const std::optional<pipeline::FrameRate> image_rate =
       a.fps.empty() ? std::nullopt : std::optional<pipeline::FrameRate>(parse_rate(a.fps));
   const Shard shard = a.shard.empty() ? Shard{} : parse_shard(a.shard);
   const std::optional<FrameRange> frames = a.frames.empty() ? std::nullopt : std::optional(parse_frames(a.frames));
-  if (frames && a.max_frames > 0) throw CommandError(kExitUsage, "--frames and --max-frames both limit the frames: give one");
+  if (frames && a.max_frames > 0)
+    throw CommandError(kExitUsage, "--frames and --max-frames both limit the frames: give one");
 
   std::shared_ptr<const model::FlowModel> model;
   try {
@@ -175,7 +182,8 @@ void run_convert(const ConvertArgs& a) {
   }
   std::fprintf(stderr, "neuflow convert: %zu input%s, %zu converted, %zu failed\n", inputs.size(),
                inputs.size() == 1 ? "" : "s", inputs.size() - failed, failed);
-  for (std::size_t i = 0; i < inputs.size(); ++i) std::fprintf(stderr, "%s\n", summary_line(inputs[i], outcomes[i]).c_str());
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    std::fprintf(stderr, "%s\n", summary_line(inputs[i], outcomes[i]).c_str());
   if (failed > 0) {
     throw CommandError(exit_code, "convert: " + std::to_string(failed) + " of " + std::to_string(inputs.size()) +
                                       " inputs failed (exit code of the first failure)");
@@ -198,7 +206,8 @@ void register_convert(CLI::App& app) {
   sub->add_option("--output,-o", args->output, "Output folder; each input gets a sub-folder named after it")
       ->required();
   sub->add_option("--pair", args->pairs, "Two images to compute one flow between (repeatable)");
-  sub->add_option("--format", args->format, "Flow file format: flo (Middlebury), npy (H x W x 2 float32) or png (KITTI 16-bit)")
+  sub->add_option("--format", args->format,
+                  "Flow file format: flo (Middlebury), npy (H x W x 2 float32) or png (KITTI 16-bit)")
       ->check(CLI::IsMember({"flo", "npy", "png"}))
       ->capture_default_str();
   sub->add_option("--viz", args->viz,

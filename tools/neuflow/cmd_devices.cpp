@@ -16,8 +16,9 @@ void run_devices() {
     throw CommandError(kExitUnavailable, std::string("devices: ") + e.what());
   }
   if (devices.empty()) {
-    throw CommandError(kExitUnavailable, "devices: Vulkan found no device (install the GPU's Vulkan driver, or "
-                                         "mesa-vulkan-drivers for lavapipe on the CPU)");
+    throw CommandError(kExitUnavailable,
+                       "devices: Vulkan found no device (install the GPU's Vulkan driver, or "
+                       "mesa-vulkan-drivers for lavapipe on the CPU)");
   }
   int first_gpu = -1;
   for (const auto& d : devices) {
@@ -27,8 +28,8 @@ void run_devices() {
     std::printf("%d: %s\n", d.index, d.name.c_str());
     std::printf("   type: %s%s\n", d.type.c_str(),
                 d.index == first_gpu ? " (what --backend auto uses)"
-                : d.is_gpu()          ? ""
-                                      : " (not a GPU: only --backend vulkan uses it)");
+                : d.is_gpu()         ? ""
+                                     : " (not a GPU: only --backend vulkan uses it)");
     std::printf("   Vulkan %s, %s\n", d.api_version.c_str(), d.driver.c_str());
     std::printf("   memory: %llu MiB device-local, at most %llu MiB per buffer\n",
                 static_cast<unsigned long long>(d.memory_bytes >> 20),

@@ -69,8 +69,8 @@ class ProgressPrinter {
     if (p.done == 1) last_ = 0;
     if (p.done != p.total && p.elapsed_seconds - last_ < 5.0) return;
     last_ = p.elapsed_seconds;
-    std::fprintf(stderr, "eval: %s %zu/%zu pairs, EPE %.3f so far, %.2f s/pair\n", p.set.name.c_str(), p.done,
-                 p.total, p.so_far.epe, p.elapsed_seconds / static_cast<double>(p.done));
+    std::fprintf(stderr, "eval: %s %zu/%zu pairs, EPE %.3f so far, %.2f s/pair\n", p.set.name.c_str(), p.done, p.total,
+                 p.so_far.epe, p.elapsed_seconds / static_cast<double>(p.done));
   }
 
  private:
@@ -127,7 +127,7 @@ void run(const EvalArgs& a) {
   const auto dataset = eval::parse_dataset(a.dataset);
   if (!dataset) throw CommandError(kExitUsage, "eval: unknown dataset '" + a.dataset + "'");
   eval::LayoutOptions layout;
-  layout.sintel_pass = a.pass == "clean" ? eval::SintelPass::clean
+  layout.sintel_pass = a.pass == "clean"   ? eval::SintelPass::clean
                        : a.pass == "final" ? eval::SintelPass::final
                                            : eval::SintelPass::both;
   const std::vector<eval::EvalSet> sets = eval::discover_sets(*dataset, a.root, layout);
@@ -193,7 +193,8 @@ void run_mapping_errors(const EvalArgs& a) {
 
 void register_eval(CLI::App& app) {
   auto a = std::make_shared<EvalArgs>();
-  auto* cmd = app.add_subcommand("eval", "Accuracy on MPI-Sintel, KITTI-2015, Middlebury or FlyingChairs as the paper reports it");
+  auto* cmd = app.add_subcommand(
+      "eval", "Accuracy on MPI-Sintel, KITTI-2015, Middlebury or FlyingChairs as the paper reports it");
   cmd->footer(kFooter);
   cmd->add_option("--dataset,-d", a->dataset, "Benchmark layout under ROOT")
       ->required()
@@ -201,7 +202,8 @@ void register_eval(CLI::App& app) {
   cmd->add_option("ROOT", a->root, "The dataset's folder")->required();
   auto* source = cmd->add_option_group("source", "What to score (exactly one)");
   auto* model = source->add_option("--model,-m", a->model, "NeuFlow-V2 checkpoint (.pth) to run on every pair");
-  source->add_option("--predictions", a->predictions, "Score precomputed flow files from this folder instead (naming below)");
+  source->add_option("--predictions", a->predictions,
+                     "Score precomputed flow files from this folder instead (naming below)");
   source->require_option(1);
   cmd->add_option("--pass", a->pass, "Sintel passes to evaluate")
       ->capture_default_str()

@@ -8,8 +8,8 @@
 #include <string>
 
 #include "commands.hpp"
-#include "fetch_model/fetch.hpp"
 #include "fetch_model/error.hpp"
+#include "fetch_model/fetch.hpp"
 #include "fetch_model/hash.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
@@ -33,10 +33,14 @@ struct FetchModelArgs {
 
 int fetch_exit_code(const FetchError& e) {
   switch (e.kind()) {
-    case FetchError::Kind::kUnavailable: return kExitUnavailable;
-    case FetchError::Kind::kIntegrity: return kExitDataError;
-    case FetchError::Kind::kLocalIo: return kExitCantCreate;
-    case FetchError::Kind::kInterrupted: return kExitInterrupted;
+    case FetchError::Kind::kUnavailable:
+      return kExitUnavailable;
+    case FetchError::Kind::kIntegrity:
+      return kExitDataError;
+    case FetchError::Kind::kLocalIo:
+      return kExitCantCreate;
+    case FetchError::Kind::kInterrupted:
+      return kExitInterrupted;
   }
   return kExitFailure;
 }
@@ -81,11 +85,11 @@ void run_fetch_model(const FetchModelArgs& a) {
     throw CommandError(fetch_exit_code(e), message);
   }
   if (result.downloaded) {
-    std::fprintf(stderr, "%s: downloaded %.1f MB from %s, git blob SHA-1 %s verified\n",
-                 request.destination.c_str(), static_cast<double>(result.bytes) * 1e-6, request.url.c_str(),
-                 result.sha1.c_str());
+    std::fprintf(stderr, "%s: downloaded %.1f MB from %s, git blob SHA-1 %s verified\n", request.destination.c_str(),
+                 static_cast<double>(result.bytes) * 1e-6, request.url.c_str(), result.sha1.c_str());
   } else {
-    std::fprintf(stderr, "%s: already there and verified (git blob SHA-1 %s); nothing downloaded (--force fetches it again)\n",
+    std::fprintf(stderr,
+                 "%s: already there and verified (git blob SHA-1 %s); nothing downloaded (--force fetches it again)\n",
                  request.destination.c_str(), result.sha1.c_str());
   }
   std::printf("%s\n", request.destination.c_str());
@@ -111,9 +115,11 @@ void register_fetch_model(CLI::App& app) {
                   "Expect this git blob SHA-1 (`git hash-object FILE`) instead of the pinned one, e.g. for a mirror "
                   "with its own copy; the file must then also load as a NeuFlow-V2 checkpoint")
       ->check([](const std::string& text) {
-        return is_sha1_hex(text) ? std::string() : "wants 40 hex digits (as `git hash-object FILE` prints), got '" + text + "'";
+        return is_sha1_hex(text) ? std::string()
+                                 : "wants 40 hex digits (as `git hash-object FILE` prints), got '" + text + "'";
       });
-  sub->add_flag("--force", args->force, "Download even if the file is already there, replacing it once the new one verifies");
+  sub->add_flag("--force", args->force,
+                "Download even if the file is already there, replacing it once the new one verifies");
   sub->add_option("--connect-timeout", args->connect_timeout_s, "Give up connecting after this many seconds")
       ->capture_default_str()
       ->check(CLI::Range(1L, 600L));

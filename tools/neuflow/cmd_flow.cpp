@@ -88,7 +88,8 @@ void register_flow(CLI::App& app) {
   sub->add_option("--model,-m", args->model, "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth")->required();
   add_session_options(*sub, args->session);
   sub->add_option("--viz", args->viz, "Also write the colour-wheel rendering of the flow to this PNG");
-  sub->add_option("--max-flow", args->max_flow, "Magnitude (px) of full saturation in --viz; default: the image's largest");
+  sub->add_option("--max-flow", args->max_flow,
+                  "Magnitude (px) of full saturation in --viz; default: the image's largest");
   sub->add_option("IMG0", args->image0, "First frame")->required();
   sub->add_option("IMG1", args->image1, "Second frame")->required();
   sub->add_option("OUT", args->output, "Output flow file: .flo, .npy or .png (KITTI 16-bit)")->required();

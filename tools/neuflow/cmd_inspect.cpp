@@ -62,8 +62,7 @@ void run_inspect(const std::string& path, bool list) {
   if (mismatch) {
     std::printf("architecture: not NeuFlow-V2: %s\n", mismatch->c_str());
   } else {
-    std::printf("architecture: NeuFlow-V2 (all %zu tensors match)\n",
-                model::neuflow_v2_parameters().size());
+    std::printf("architecture: NeuFlow-V2 (all %zu tensors match)\n", model::neuflow_v2_parameters().size());
   }
 
   if (list) {
@@ -72,23 +71,21 @@ void run_inspect(const std::string& path, bool list) {
     std::printf("\n");
     for (const auto& key : checkpoint.keys) {
       const auto& tensor = checkpoint.tensors.at(key);
-      std::printf("%-*s  %-18s %s\n", static_cast<int>(width), key.c_str(),
-                  shape_text(tensor.shape).c_str(), tensor.dtype.c_str());
+      std::printf("%-*s  %-18s %s\n", static_cast<int>(width), key.c_str(), shape_text(tensor.shape).c_str(),
+                  tensor.dtype.c_str());
     }
   }
   std::fflush(stdout);
 
   if (mismatch) {
-    throw CommandError(kExitDataError,
-                       "inspect: '" + path + "' is not a NeuFlow-V2 checkpoint: " + *mismatch);
+    throw CommandError(kExitDataError, "inspect: '" + path + "' is not a NeuFlow-V2 checkpoint: " + *mismatch);
   }
 }
 
 }  // namespace
 
 void register_inspect(CLI::App& app) {
-  auto* sub = app.add_subcommand(
-      "inspect", "Describe a PyTorch checkpoint (.pth) and check it against NeuFlow-V2");
+  auto* sub = app.add_subcommand("inspect", "Describe a PyTorch checkpoint (.pth) and check it against NeuFlow-V2");
   auto path = std::make_shared<std::string>();
   auto list = std::make_shared<bool>(false);
   sub->add_option("checkpoint", *path, "PyTorch checkpoint (.pth, zip format)")->required();

@@ -47,8 +47,7 @@ void run_viz(const VizOptions& options) {
     throw CommandError(exit_code_for(e), std::string("viz: ") + e.what());
   }
   const auto invalid = static_cast<std::size_t>(std::count(field.valid.begin(), field.valid.end(), 0));
-  std::printf("%s: %dx%d, %zu invalid pixels (black)\n", options.input.c_str(), field.width,
-              field.height, invalid);
+  std::printf("%s: %dx%d, %zu invalid pixels (black)\n", options.input.c_str(), field.width, field.height, invalid);
   std::printf("max flow: %.3f px (%s)\n", result.max_flow,
               options.fixed_max ? "fixed by --max-flow" : "largest valid magnitude in this field");
   std::printf("wrote %s\n", options.output.c_str());
@@ -58,18 +57,13 @@ void run_viz(const VizOptions& options) {
 
 void register_viz(CLI::App& app) {
   auto options = std::make_shared<VizOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "viz", "Render a flow file (.flo, KITTI .png, .npy) as a colour-wheel PNG");
-  cmd->add_option("FLOW", options->input, "Flow file: .flo, KITTI 16-bit .png or .npy (HxWx2)")
-      ->required();
-  cmd->add_option("-o,--output", options->output, "Output image (.png)")
-      ->required()
-      ->check(require_png_name);
-  CLI::Option* max_flow =
-      cmd->add_option("--max-flow", options->max_flow,
-                      "Magnitude in px drawn fully saturated; larger vectors are dimmed. "
-                      "Default: the largest valid magnitude of the field")
-          ->check(CLI::PositiveNumber);
+  CLI::App* cmd = app.add_subcommand("viz", "Render a flow file (.flo, KITTI .png, .npy) as a colour-wheel PNG");
+  cmd->add_option("FLOW", options->input, "Flow file: .flo, KITTI 16-bit .png or .npy (HxWx2)")->required();
+  cmd->add_option("-o,--output", options->output, "Output image (.png)")->required()->check(require_png_name);
+  CLI::Option* max_flow = cmd->add_option("--max-flow", options->max_flow,
+                                          "Magnitude in px drawn fully saturated; larger vectors are dimmed. "
+                                          "Default: the largest valid magnitude of the field")
+                              ->check(CLI::PositiveNumber);
   cmd->callback([options, max_flow] {
     options->fixed_max = max_flow->count() > 0;
     run_viz(*options);

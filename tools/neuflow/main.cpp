@@ -6,8 +6,8 @@
 #include <string>
 
 #include "commands.hpp"
-#include "neuflow/model/gpu_devices.hpp"
 #include "common/usage_errors.hpp"
+#include "neuflow/model/gpu_devices.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"neuflow: NeuFlow-V2 optical flow on the CPU or a GPU (Vulkan)"};

@@ -28,9 +28,7 @@ constexpr uint64_t kMaxPickleBytes = uint64_t{256} << 20;
 // Far above any real network; keeps a lying header from driving an allocation.
 constexpr int64_t kMaxDim = int64_t{1} << 40;
 
-[[noreturn]] void fail(Kind kind, const std::string& message) {
-  throw CheckpointError(kind, message);
-}
+[[noreturn]] void fail(Kind kind, const std::string& message) { throw CheckpointError(kind, message); }
 
 float half_to_float(uint16_t h) {
   const uint32_t sign = uint32_t{h & 0x8000u} << 16;
@@ -67,8 +65,10 @@ U load(const unsigned char* p, bool big_endian) {
 
 float element(const unsigned char* p, StorageDtype dtype, bool big_endian) {
   switch (dtype) {
-    case StorageDtype::kFloat32: return std::bit_cast<float>(load<uint32_t>(p, big_endian));
-    case StorageDtype::kFloat16: return half_to_float(load<uint16_t>(p, big_endian));
+    case StorageDtype::kFloat32:
+      return std::bit_cast<float>(load<uint32_t>(p, big_endian));
+    case StorageDtype::kFloat16:
+      return half_to_float(load<uint16_t>(p, big_endian));
     case StorageDtype::kBFloat16:
       return std::bit_cast<float>(uint32_t{load<uint16_t>(p, big_endian)} << 16);
     case StorageDtype::kFloat64:
@@ -82,8 +82,7 @@ float element(const unsigned char* p, StorageDtype dtype, bool big_endian) {
 }
 
 // Converts `count` consecutive elements starting at `src`.
-void convert_run(const unsigned char* src, std::size_t count, StorageDtype dtype, bool big_endian,
-                 float* dst) {
+void convert_run(const unsigned char* src, std::size_t count, StorageDtype dtype, bool big_endian, float* dst) {
   if (dtype == StorageDtype::kFloat32 && big_endian == (std::endian::native == std::endian::big)) {
     std::memcpy(dst, src, count * sizeof(float));
     return;
@@ -91,7 +90,6 @@ void convert_run(const unsigned char* src, std::size_t count, StorageDtype dtype
   const std::size_t step = detail::dtype_size(dtype);
   for (std::size_t i = 0; i < count; ++i) dst[i] = element(src + i * step, dtype, big_endian);
 }
-
 
 struct Storage {
   std::vector<unsigned char> bytes;
@@ -123,8 +121,7 @@ class Loader {
     Checkpoint checkpoint;
     checkpoint.path = path_.string();
     checkpoint.container = "PyTorch zip (folder '" + folder + "'), pickle protocol " +
-                           (unpickled.protocol() ? std::to_string(unpickled.protocol())
-                                                 : std::string("unknown"));
+                           (unpickled.protocol() ? std::to_string(unpickled.protocol()) : std::string("unknown"));
     if (big_endian_) checkpoint.container += ", big-endian storages";
 
     const DictValue& state = find_state_dict(unpickled.root(), checkpoint.wrapper);
@@ -133,13 +130,13 @@ class Loader {
     for (const auto& [key_value, value] : state.entries) {
       const auto* key = std::get_if<std::string>(&key_value->v);
       if (key == nullptr) {
-        fail(Kind::kFormat, std::string("state dict has a key of type ") +
-                                detail::type_name(*key_value) + " (expected str)");
+        fail(Kind::kFormat,
+             std::string("state dict has a key of type ") + detail::type_name(*key_value) + " (expected str)");
       }
       const auto* tensor = std::get_if<TensorRef>(&value->v);
       if (tensor == nullptr) {
-        fail(Kind::kUnsupported, "state dict entry '" + *key + "' is a " +
-                                     detail::type_name(*value) + ", not a tensor");
+        fail(Kind::kUnsupported,
+             "state dict entry '" + *key + "' is a " + detail::type_name(*value) + ", not a tensor");
       }
       entries.emplace_back(*key, tensor);
     }
@@ -187,8 +184,7 @@ class Loader {
     std::vector<std::string> folders;
     for (const auto& name : zip.names()) {
       static constexpr std::string_view kPkl = "/data.pkl";
-      if (name.size() > kPkl.size() && name.ends_with(kPkl) &&
-          name.find('/') == name.size() - kPkl.size()) {
+      if (name.size() > kPkl.size() && name.ends_with(kPkl) && name.find('/') == name.size() - kPkl.size()) {
         folders.push_back(name.substr(0, name.size() - kPkl.size() + 1));
       }
     }
@@ -196,8 +192,7 @@ class Loader {
       fail(Kind::kFormat, "zip archive has no '<folder>/data.pkl' entry: not a PyTorch checkpoint");
     }
     if (folders.size() > 1) {
-      fail(Kind::kFormat, "zip archive has several data.pkl entries ('" + folders[0] + "', '" +
-                              folders[1] + "')");
+      fail(Kind::kFormat, "zip archive has several data.pkl entries ('" + folders[0] + "', '" + folders[1] + "')");
     }
     return folders[0];
   }
@@ -214,8 +209,7 @@ class Loader {
   static const DictValue& find_state_dict(const PickleValue& root, std::string& wrapper) {
     const auto* top = std::get_if<DictValue>(&root.v);
     if (top == nullptr) {
-      fail(Kind::kUnsupported, std::string("the pickled object is a ") + detail::type_name(root) +
-                                   ", not a dict");
+      fail(Kind::kUnsupported, std::string("the pickled object is a ") + detail::type_name(root) + ", not a dict");
     }
     for (const char* name : {"model", "state_dict"}) {
       const PickleValue* inner = lookup(*top, name);
@@ -223,8 +217,8 @@ class Loader {
       if (inner != nullptr && !std::holds_alternative<TensorRef>(inner->v)) {
         const auto* dict = std::get_if<DictValue>(&inner->v);
         if (dict == nullptr) {
-          fail(Kind::kUnsupported, std::string("entry '") + name + "' is a " +
-                                       detail::type_name(*inner) + ", not a state dict");
+          fail(Kind::kUnsupported,
+               std::string("entry '") + name + "' is a " + detail::type_name(*inner) + ", not a state dict");
         }
         wrapper = name;
         return *dict;
@@ -235,8 +229,8 @@ class Loader {
         const auto* key = std::get_if<std::string>(&entry.first->v);
         fail(Kind::kUnsupported,
              "top-level dict has neither a 'model' nor a 'state_dict' entry and is not a state "
-             "dict (entry '" + (key ? *key : std::string("?")) + "' is a " +
-                 detail::type_name(*entry.second) + ")");
+             "dict (entry '" +
+                 (key ? *key : std::string("?")) + "' is a " + detail::type_name(*entry.second) + ")");
       }
     }
     wrapper = "bare";
@@ -258,8 +252,7 @@ class Loader {
     return tensor;
   }
 
-  const Storage& storage(const detail::ZipArchive& zip, const std::string& folder,
-                         const StorageRef& ref) {
+  const Storage& storage(const detail::ZipArchive& zip, const std::string& folder, const StorageRef& ref) {
     if (auto it = storages_.find(ref.key); it != storages_.end()) {
       if (it->second.numel != ref.numel) {
         fail(Kind::kFormat, "storage '" + ref.key + "' is declared with different sizes");
@@ -272,8 +265,8 @@ class Loader {
     const uint64_t element_size = detail::dtype_size(ref.dtype);
     if (static_cast<uint64_t>(ref.numel) > *size / element_size) {
       fail(Kind::kFormat, "storage '" + ref.key + "' declares " + std::to_string(ref.numel) + " " +
-                              detail::dtype_name(ref.dtype) + " elements but '" + entry +
-                              "' holds only " + std::to_string(*size) + " bytes");
+                              detail::dtype_name(ref.dtype) + " elements but '" + entry + "' holds only " +
+                              std::to_string(*size) + " bytes");
     }
     Storage s;
     s.bytes = zip.read(entry, *size);
@@ -281,8 +274,8 @@ class Loader {
     return storages_.emplace(ref.key, std::move(s)).first->second;
   }
 
-  CheckpointTensor materialize(const detail::ZipArchive& zip, const std::string& folder,
-                               const std::string& key, const TensorRef& ref) {
+  CheckpointTensor materialize(const detail::ZipArchive& zip, const std::string& folder, const std::string& key,
+                               const TensorRef& ref) {
     const StorageRef& sref = *ref.storage;
     const auto where = [&] { return "tensor '" + key + "' " + shape_text(ref.size); };
 
@@ -297,8 +290,7 @@ class Loader {
     // The view must lie inside the storage: offset + sum((size-1)*stride) < storage numel.
     if (ref.storage_offset > sref.numel) {
       fail(Kind::kFormat, where() + " starts at offset " + std::to_string(ref.storage_offset) +
-                              " beyond its storage '" + sref.key + "' of " +
-                              std::to_string(sref.numel) + " elements");
+                              " beyond its storage '" + sref.key + "' of " + std::to_string(sref.numel) + " elements");
     }
     if (numel > 0) {
       int64_t last = ref.storage_offset;
@@ -309,16 +301,16 @@ class Loader {
                    __builtin_add_overflow(last, extent, &last);
       }
       if (overflow || last >= sref.numel) {
-        fail(Kind::kFormat, where() + " (offset " + std::to_string(ref.storage_offset) +
-                                ", stride " + shape_text(ref.stride) + ") does not fit in storage '" +
-                                sref.key + "' of " + std::to_string(sref.numel) + " elements");
+        fail(Kind::kFormat, where() + " (offset " + std::to_string(ref.storage_offset) + ", stride " +
+                                shape_text(ref.stride) + ") does not fit in storage '" + sref.key + "' of " +
+                                std::to_string(sref.numel) + " elements");
       }
     }
     // Broadcast views (stride 0) could claim more elements than the file holds; refuse those
     // rather than allocate for them.
     if (numel > sref.numel) {
-      fail(Kind::kUnsupported, where() + " has more elements than its storage '" + sref.key +
-                                   "' (" + std::to_string(sref.numel) + ")");
+      fail(Kind::kUnsupported,
+           where() + " has more elements than its storage '" + sref.key + "' (" + std::to_string(sref.numel) + ")");
     }
 
     const Storage& st = storage(zip, folder, sref);
@@ -338,8 +330,8 @@ class Loader {
       expected *= ref.size[i];
     }
     if (contiguous) {
-      convert_run(base + static_cast<std::size_t>(ref.storage_offset) * esize,
-                  static_cast<std::size_t>(numel), sref.dtype, big_endian_, tensor.data.data());
+      convert_run(base + static_cast<std::size_t>(ref.storage_offset) * esize, static_cast<std::size_t>(numel),
+                  sref.dtype, big_endian_, tensor.data.data());
       return tensor;
     }
     // General strided view: walk the index space in C order (odometer on all but the last dim).
@@ -351,8 +343,7 @@ class Loader {
     int64_t offset = ref.storage_offset;  // of index (i0, ..., i_{r-2}, 0)
     for (int64_t done = 0; done < numel; done += inner) {
       for (int64_t j = 0; j < inner; ++j) {
-        *out++ = element(base + static_cast<std::size_t>(offset + j * inner_stride) * esize,
-                         sref.dtype, big_endian_);
+        *out++ = element(base + static_cast<std::size_t>(offset + j * inner_stride) * esize, sref.dtype, big_endian_);
       }
       for (std::size_t d = rank - 1; d-- > 0;) {
         offset += ref.stride[d];

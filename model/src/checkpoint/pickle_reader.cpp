@@ -9,12 +9,18 @@ namespace neuflow::model::detail {
 
 const char* dtype_name(StorageDtype dtype) {
   switch (dtype) {
-    case StorageDtype::kFloat32: return "float32";
-    case StorageDtype::kFloat16: return "float16";
-    case StorageDtype::kBFloat16: return "bfloat16";
-    case StorageDtype::kFloat64: return "float64";
-    case StorageDtype::kInt64: return "int64";
-    case StorageDtype::kInt32: return "int32";
+    case StorageDtype::kFloat32:
+      return "float32";
+    case StorageDtype::kFloat16:
+      return "float16";
+    case StorageDtype::kBFloat16:
+      return "bfloat16";
+    case StorageDtype::kFloat64:
+      return "float64";
+    case StorageDtype::kInt64:
+      return "int64";
+    case StorageDtype::kInt32:
+      return "int32";
   }
   return "?";
 }
@@ -22,18 +28,21 @@ const char* dtype_name(StorageDtype dtype) {
 std::size_t dtype_size(StorageDtype dtype) {
   switch (dtype) {
     case StorageDtype::kFloat16:
-    case StorageDtype::kBFloat16: return 2;
+    case StorageDtype::kBFloat16:
+      return 2;
     case StorageDtype::kFloat32:
-    case StorageDtype::kInt32: return 4;
+    case StorageDtype::kInt32:
+      return 4;
     case StorageDtype::kFloat64:
-    case StorageDtype::kInt64: return 8;
+    case StorageDtype::kInt64:
+      return 8;
   }
   return 0;
 }
 
 const char* type_name(const PickleValue& value) {
-  static constexpr const char* kNames[] = {"None",  "bool", "int",    "float",   "str",   "tuple",
-                                           "list",  "dict", "global", "storage", "tensor"};
+  static constexpr const char* kNames[] = {"None", "bool", "int",    "float",   "str",   "tuple",
+                                           "list", "dict", "global", "storage", "tensor"};
   return kNames[value.v.index()];
 }
 
@@ -94,8 +103,7 @@ class Unpickler {
         case 0x80: {  // PROTO
           const int protocol = u8();
           if (protocol < 2 || protocol > 5) {
-            fail(Kind::kUnsupported, "pickle protocol " + std::to_string(protocol) +
-                                         " (supported: 2 to 5)");
+            fail(Kind::kUnsupported, "pickle protocol " + std::to_string(protocol) + " (supported: 2 to 5)");
           }
           out_.protocol_ = protocol;
           break;
@@ -103,46 +111,88 @@ class Unpickler {
         case 0x95:  // FRAME (protocol 4+): a length hint only
           take(8);
           break;
-        case '}': push(make(DictValue{})); break;    // EMPTY_DICT
-        case ']': push(make(ListValue{})); break;    // EMPTY_LIST
-        case ')': push(make(TupleValue{})); break;   // EMPTY_TUPLE
-        case 'N': push(make(NoneValue{})); break;    // NONE
-        case 0x88: push(make(true)); break;          // NEWTRUE
-        case 0x89: push(make(false)); break;         // NEWFALSE
-        case '(':                                    // MARK
+        case '}':
+          push(make(DictValue{}));
+          break;  // EMPTY_DICT
+        case ']':
+          push(make(ListValue{}));
+          break;  // EMPTY_LIST
+        case ')':
+          push(make(TupleValue{}));
+          break;  // EMPTY_TUPLE
+        case 'N':
+          push(make(NoneValue{}));
+          break;  // NONE
+        case 0x88:
+          push(make(true));
+          break;  // NEWTRUE
+        case 0x89:
+          push(make(false));
+          break;   // NEWFALSE
+        case '(':  // MARK
           if (marks_.size() >= limits_.max_marks) fail(Kind::kFormat, "MARKs nested too deeply");
           marks_.push_back(stack_.size());
           break;
-        case 'X': push(make(string(u32()))); break;      // BINUNICODE
-        case 0x8c: push(make(string(u8()))); break;      // SHORT_BINUNICODE
-        case 0x8d: push(make(string(u64()))); break;     // BINUNICODE8
-        case 'K': push(make(int64_t{u8()})); break;      // BININT1
-        case 'M': push(make(int64_t{u16()})); break;     // BININT2
-        case 'J':                                        // BININT
+        case 'X':
+          push(make(string(u32())));
+          break;  // BINUNICODE
+        case 0x8c:
+          push(make(string(u8())));
+          break;  // SHORT_BINUNICODE
+        case 0x8d:
+          push(make(string(u64())));
+          break;  // BINUNICODE8
+        case 'K':
+          push(make(int64_t{u8()}));
+          break;  // BININT1
+        case 'M':
+          push(make(int64_t{u16()}));
+          break;   // BININT2
+        case 'J':  // BININT
           push(make(int64_t{static_cast<int32_t>(u32())}));
           break;
-        case 0x8a: push(make(long1())); break;           // LONG1
-        case 'G': push(make(binfloat())); break;         // BINFLOAT
-        case 'q': memo_put(u8()); break;                 // BINPUT
-        case 'r': memo_put(u32()); break;                // LONG_BINPUT
-        case 0x94: memo_put(memo_count_); break;         // MEMOIZE: index len(memo)
-        case 'h': push(memo_get(u8())); break;           // BINGET
-        case 'j': push(memo_get(u32())); break;          // LONG_BINGET
-        case 't': {                                      // TUPLE
+        case 0x8a:
+          push(make(long1()));
+          break;  // LONG1
+        case 'G':
+          push(make(binfloat()));
+          break;  // BINFLOAT
+        case 'q':
+          memo_put(u8());
+          break;  // BINPUT
+        case 'r':
+          memo_put(u32());
+          break;  // LONG_BINPUT
+        case 0x94:
+          memo_put(memo_count_);
+          break;  // MEMOIZE: index len(memo)
+        case 'h':
+          push(memo_get(u8()));
+          break;  // BINGET
+        case 'j':
+          push(memo_get(u32()));
+          break;     // LONG_BINGET
+        case 't': {  // TUPLE
           TupleValue tuple{pop_mark()};
           push(make(std::move(tuple)));
           break;
         }
-        case 0x85: tuple_n(1); break;                    // TUPLE1
-        case 0x86: tuple_n(2); break;                    // TUPLE2
-        case 0x87: tuple_n(3); break;                    // TUPLE3
-        case 's': {                                      // SETITEM
+        case 0x85:
+          tuple_n(1);
+          break;  // TUPLE1
+        case 0x86:
+          tuple_n(2);
+          break;  // TUPLE2
+        case 0x87:
+          tuple_n(3);
+          break;     // TUPLE3
+        case 's': {  // SETITEM
           const PickleValue* value = pop();
           const PickleValue* key = pop();
           dict_at_top().entries.emplace_back(key, value);
           break;
         }
-        case 'u': {                                      // SETITEMS
+        case 'u': {  // SETITEMS
           const auto items = pop_mark();
           if (items.size() % 2 != 0) fail(Kind::kFormat, "SETITEMS with an odd number of items");
           auto& dict = dict_at_top();
@@ -151,24 +201,24 @@ class Unpickler {
           }
           break;
         }
-        case 'a': {                                      // APPEND
+        case 'a': {  // APPEND
           const PickleValue* value = pop();
           list_at_top().items.push_back(value);
           break;
         }
-        case 'e': {                                      // APPENDS
+        case 'e': {  // APPENDS
           const auto items = pop_mark();
           auto& list = list_at_top();
           list.items.insert(list.items.end(), items.begin(), items.end());
           break;
         }
-        case 'c': {                                      // GLOBAL "module\nname\n"
+        case 'c': {  // GLOBAL "module\nname\n"
           const std::string module = line();
           const std::string name = line();
           push(global(module, name));
           break;
         }
-        case 0x93: {                                     // STACK_GLOBAL
+        case 0x93: {  // STACK_GLOBAL
           const PickleValue* name = pop();
           const PickleValue* module = pop();
           const auto* m = std::get_if<std::string>(&module->v);
@@ -177,34 +227,34 @@ class Unpickler {
           push(global(*m, *n));
           break;
         }
-        case 'R': {                                      // REDUCE
+        case 'R': {  // REDUCE
           const PickleValue* args = pop();
           const PickleValue* callable = pop();
           push(reduce(*callable, *args));
           break;
         }
-        case 'Q': push(persistent_id(*pop())); break;    // BINPERSID
-        case 'b': {                                      // BUILD
+        case 'Q':
+          push(persistent_id(*pop()));
+          break;     // BINPERSID
+        case 'b': {  // BUILD
           const PickleValue* state = pop();
           build(top(), *state);
           break;
         }
-        case '.': {                                      // STOP
+        case '.': {  // STOP
           if (!marks_.empty()) fail(Kind::kFormat, "STOP inside an open MARK");
           out_.root_ = pop();
           return std::move(out_);
         }
         default:
-          fail(Kind::kUnsupported, "pickle opcode 0x" + hex(op) + describe(op) +
-                                       ", which a state dict does not use");
+          fail(Kind::kUnsupported, "pickle opcode 0x" + hex(op) + describe(op) + ", which a state dict does not use");
       }
     }
   }
 
  private:
   [[noreturn]] void fail(Kind kind, const std::string& message) const {
-    throw CheckpointError(kind, "data.pkl: " + message + " (at byte " + std::to_string(op_pos_) +
-                                    ")");
+    throw CheckpointError(kind, "data.pkl: " + message + " (at byte " + std::to_string(op_pos_) + ")");
   }
 
   static std::string hex(unsigned v) {
@@ -219,9 +269,8 @@ class Unpickler {
   // --- reading -------------------------------------------------------------------------
   const unsigned char* take(std::size_t n) {
     if (n > size_ - pos_) {
-      throw CheckpointError(Kind::kFormat, "data.pkl: truncated pickle (an opcode at byte " +
-                                               std::to_string(op_pos_) + " needs " +
-                                               std::to_string(n) + " more bytes, " +
+      throw CheckpointError(Kind::kFormat, "data.pkl: truncated pickle (an opcode at byte " + std::to_string(op_pos_) +
+                                               " needs " + std::to_string(n) + " more bytes, " +
                                                std::to_string(size_ - pos_) + " left)");
     }
     const unsigned char* p = data_ + pos_;
@@ -230,9 +279,8 @@ class Unpickler {
   }
   unsigned u8() {
     if (pos_ >= size_) {
-      throw CheckpointError(Kind::kFormat,
-                            "data.pkl: truncated pickle (ends at byte " + std::to_string(size_) +
-                                " without a STOP opcode)");
+      throw CheckpointError(Kind::kFormat, "data.pkl: truncated pickle (ends at byte " + std::to_string(size_) +
+                                               " without a STOP opcode)");
     }
     return data_[pos_++];
   }
@@ -248,8 +296,8 @@ class Unpickler {
 
   std::string string(uint64_t n) {
     if (n > limits_.max_string) {
-      fail(Kind::kFormat, "string of " + std::to_string(n) + " bytes exceeds the limit of " +
-                              std::to_string(limits_.max_string));
+      fail(Kind::kFormat,
+           "string of " + std::to_string(n) + " bytes exceeds the limit of " + std::to_string(limits_.max_string));
     }
     const unsigned char* p = take(static_cast<std::size_t>(n));
     return std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(n));
@@ -321,8 +369,7 @@ class Unpickler {
     if (marks_.empty()) fail(Kind::kFormat, "opcode needs a MARK but none is open");
     const std::size_t mark = marks_.back();
     marks_.pop_back();
-    std::vector<const PickleValue*> items(stack_.begin() + static_cast<std::ptrdiff_t>(mark),
-                                          stack_.end());
+    std::vector<const PickleValue*> items(stack_.begin() + static_cast<std::ptrdiff_t>(mark), stack_.end());
     stack_.resize(mark);
     return items;
   }
@@ -345,8 +392,8 @@ class Unpickler {
 
   void memo_put(uint64_t index) {
     if (index >= limits_.max_memo) {
-      fail(Kind::kFormat, "memo index " + std::to_string(index) + " exceeds the limit of " +
-                              std::to_string(limits_.max_memo));
+      fail(Kind::kFormat,
+           "memo index " + std::to_string(index) + " exceeds the limit of " + std::to_string(limits_.max_memo));
     }
     const PickleValue* value = top();
     if (index >= memo_.size()) memo_.resize(static_cast<std::size_t>(index) + 1, nullptr);
@@ -367,26 +414,22 @@ class Unpickler {
         return make(GlobalRef{allowed.global, allowed.dtype, module + "." + name});
       }
     }
-    fail(Kind::kUnsafe,
-         "refusing disallowed global '" + printable(module) + "." + printable(name) +
-             "': a checkpoint may only reference collections.OrderedDict, "
-             "torch._utils._rebuild_tensor_v2, torch._utils._rebuild_parameter and torch "
-             "storage types; nothing from this file was executed");
+    fail(Kind::kUnsafe, "refusing disallowed global '" + printable(module) + "." + printable(name) +
+                            "': a checkpoint may only reference collections.OrderedDict, "
+                            "torch._utils._rebuild_tensor_v2, torch._utils._rebuild_parameter and torch "
+                            "storage types; nothing from this file was executed");
   }
 
-  static const TupleValue* as_tuple(const PickleValue& value) {
-    return std::get_if<TupleValue>(&value.v);
-  }
+  static const TupleValue* as_tuple(const PickleValue& value) { return std::get_if<TupleValue>(&value.v); }
 
   std::vector<int64_t> int_tuple(const PickleValue& value, const char* what) {
     const auto* tuple = as_tuple(value);
     if (tuple == nullptr) {
-      fail(Kind::kFormat, std::string("tensor ") + what + " is a " + type_name(value) +
-                              ", not a tuple");
+      fail(Kind::kFormat, std::string("tensor ") + what + " is a " + type_name(value) + ", not a tuple");
     }
     if (tuple->items.size() > limits_.max_dims) {
-      fail(Kind::kFormat, std::string("tensor ") + what + " has " +
-                              std::to_string(tuple->items.size()) + " dimensions");
+      fail(Kind::kFormat,
+           std::string("tensor ") + what + " has " + std::to_string(tuple->items.size()) + " dimensions");
     }
     std::vector<int64_t> out;
     for (const PickleValue* item : tuple->items) {
@@ -412,8 +455,7 @@ class Unpickler {
       case Global::kRebuildTensorV2: {
         // (storage, storage_offset, size, stride, requires_grad, backward_hooks[, metadata])
         if (a.size() != 6 && a.size() != 7) {
-          fail(Kind::kFormat, "_rebuild_tensor_v2 with " + std::to_string(a.size()) +
-                                  " arguments (expected 6 or 7)");
+          fail(Kind::kFormat, "_rebuild_tensor_v2 with " + std::to_string(a.size()) + " arguments (expected 6 or 7)");
         }
         const auto* storage = std::get_if<StorageRef>(&a[0]->v);
         if (storage == nullptr) {
@@ -460,8 +502,8 @@ class Unpickler {
       fail(Kind::kFormat, "persistent id has an invalid storage key");
     }
     for (const char c : *key) {
-      const bool ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') ||
-                      c == '_' || c == '-' || c == '.';
+      const bool ok = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' ||
+                      c == '-' || c == '.';
       if (!ok) fail(Kind::kFormat, "persistent id has an invalid storage key '" + printable(*key) + "'");
     }
     if (location == nullptr) fail(Kind::kFormat, "persistent id has no location string");

@@ -20,8 +20,8 @@
 namespace neuflow::model::detail {
 
 enum class StorageDtype { kFloat32, kFloat16, kBFloat16, kFloat64, kInt64, kInt32 };
-const char* dtype_name(StorageDtype dtype);   // "float32", ...
-std::size_t dtype_size(StorageDtype dtype);   // bytes per element
+const char* dtype_name(StorageDtype dtype);  // "float32", ...
+std::size_t dtype_size(StorageDtype dtype);  // bytes per element
 
 // The callables and classes a state-dict pickle may name.
 enum class Global {
@@ -34,8 +34,12 @@ enum class Global {
 struct PickleValue;
 
 struct NoneValue {};
-struct TupleValue { std::vector<const PickleValue*> items; };
-struct ListValue { std::vector<const PickleValue*> items; };
+struct TupleValue {
+  std::vector<const PickleValue*> items;
+};
+struct ListValue {
+  std::vector<const PickleValue*> items;
+};
 struct DictValue {  // entries in insertion order; duplicates kept (the last one wins)
   std::vector<std::pair<const PickleValue*, const PickleValue*>> entries;
 };
@@ -60,8 +64,8 @@ struct TensorRef {
 };
 
 struct PickleValue {
-  std::variant<NoneValue, bool, int64_t, double, std::string, TupleValue, ListValue, DictValue,
-               GlobalRef, StorageRef, TensorRef>
+  std::variant<NoneValue, bool, int64_t, double, std::string, TupleValue, ListValue, DictValue, GlobalRef, StorageRef,
+               TensorRef>
       v;
 };
 

@@ -22,9 +22,7 @@ std::string libzip_message(int code) {
   return message;
 }
 
-std::string archive_message(::zip* archive) {
-  return zip_error_strerror(zip_get_error(archive));
-}
+std::string archive_message(::zip* archive) { return zip_error_strerror(zip_get_error(archive)); }
 
 // Closes a zip_file_t on scope exit.
 struct ZipFileCloser {
@@ -51,8 +49,7 @@ ZipArchive::ZipArchive(const std::filesystem::path& path) {
                               "may be truncated)");
       case ZIP_ER_INCONS:
         throw CheckpointError(Kind::kFormat,
-                              "inconsistent zip archive (truncated or corrupt): " +
-                                  libzip_message(code));
+                              "inconsistent zip archive (truncated or corrupt): " + libzip_message(code));
       case ZIP_ER_NOENT:
       case ZIP_ER_OPEN:
       case ZIP_ER_READ:
@@ -107,32 +104,26 @@ std::vector<unsigned char> ZipArchive::read(const std::string& name, uint64_t ma
   zip_stat_t st;
   zip_stat_init(&st);
   if (zip_stat_index(archive_, *index, 0, &st) != 0 || (st.valid & ZIP_STAT_SIZE) == 0) {
-    throw CheckpointError(Kind::kFormat, "cannot stat zip entry '" + name + "': " +
-                                             archive_message(archive_));
+    throw CheckpointError(Kind::kFormat, "cannot stat zip entry '" + name + "': " + archive_message(archive_));
   }
   if (st.size > max_bytes) {
-    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' is too large (" +
-                                             std::to_string(st.size) + " bytes, limit " +
-                                             std::to_string(max_bytes) + ")");
+    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' is too large (" + std::to_string(st.size) +
+                                             " bytes, limit " + std::to_string(max_bytes) + ")");
   }
   const bool stored = (st.valid & ZIP_STAT_COMP_METHOD) != 0 && st.comp_method == ZIP_CM_STORE;
   if (stored && st.size > file_size_) {
-    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' claims " +
-                                             std::to_string(st.size) +
+    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' claims " + std::to_string(st.size) +
                                              " bytes, more than the whole file");
   }
 
   // Deflate expands at most ~1032:1; anything claiming more is a bomb or corrupt.
-  if (!stored && (st.valid & ZIP_STAT_COMP_SIZE) != 0 &&
-      st.size / 1100 > st.comp_size + (uint64_t{1} << 20)) {
-    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' claims an implausible " +
-                                             "compression ratio");
+  if (!stored && (st.valid & ZIP_STAT_COMP_SIZE) != 0 && st.size / 1100 > st.comp_size + (uint64_t{1} << 20)) {
+    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' claims an implausible " + "compression ratio");
   }
 
   ZipFileCloser file{zip_fopen_index(archive_, *index, 0)};
   if (file.file == nullptr) {
-    throw CheckpointError(Kind::kFormat, "cannot open zip entry '" + name + "': " +
-                                             archive_message(archive_));
+    throw CheckpointError(Kind::kFormat, "cannot open zip entry '" + name + "': " + archive_message(archive_));
   }
 
   // Stored entries cannot be larger than the file (checked above), so their buffer is
@@ -146,16 +137,15 @@ std::vector<unsigned char> ZipArchive::read(const std::string& name, uint64_t ma
     data.resize(old + static_cast<std::size_t>(want));
     const zip_int64_t got = zip_fread(file.file, data.data() + old, want);
     if (got < 0) {
-      throw CheckpointError(Kind::kFormat, "cannot read zip entry '" + name + "': " +
-                                               zip_error_strerror(zip_file_get_error(file.file)));
+      throw CheckpointError(
+          Kind::kFormat, "cannot read zip entry '" + name + "': " + zip_error_strerror(zip_file_get_error(file.file)));
     }
     data.resize(old + static_cast<std::size_t>(got));
     if (got == 0) break;
   }
   if (data.size() != st.size) {
-    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' is truncated (" +
-                                             std::to_string(data.size()) + " of " +
-                                             std::to_string(st.size) + " bytes)");
+    throw CheckpointError(Kind::kFormat, "zip entry '" + name + "' is truncated (" + std::to_string(data.size()) +
+                                             " of " + std::to_string(st.size) + " bytes)");
   }
   // One more read reaches the end of the entry, where libzip verifies the CRC.
   unsigned char extra = 0;
@@ -163,8 +153,7 @@ std::vector<unsigned char> ZipArchive::read(const std::string& name, uint64_t ma
   if (tail != 0) {
     throw CheckpointError(Kind::kFormat,
                           "zip entry '" + name + "' is corrupt" +
-                              (tail < 0 ? std::string(": ") +
-                                              zip_error_strerror(zip_file_get_error(file.file))
+                              (tail < 0 ? std::string(": ") + zip_error_strerror(zip_file_get_error(file.file))
                                         : std::string(" (longer than its stated size)")));
   }
   return data;

@@ -15,7 +15,9 @@ class CpuBackend final : public InferenceBackend {
       : plan_(weights, height, width, convolution) {}
   int width() const override { return plan_.width(); }
   int height() const override { return plan_.height(); }
-  void encode(const Tensor& image, int slot) override { plan_.encode(stream_, image, slots_[static_cast<std::size_t>(slot)]); }
+  void encode(const Tensor& image, int slot) override {
+    plan_.encode(stream_, image, slots_[static_cast<std::size_t>(slot)]);
+  }
   // Converted into the plan's arena rather than a tensor of the session's (25 MB at 1920×1088).
   bool encode_frame(const ImageView& image, const FrameGeometry& geometry, ChannelOrder network_order,
                     int slot) override {

@@ -37,7 +37,8 @@ NetworkPlan::NetworkPlan(const NetworkWeights& w, int height, int width, CpuConv
       matching_(height / 16, width / 16, kMatchingChannels, next_region(context_, "global_matching")),
       refine_s16_(w.refine_s16, height / 16, width / 16, Iterations{}.s16, next_region(context_, "refine_s16")),
       merge_(w, height / 8, width / 8, next_region(context_, "merge_refine_s8")),
-      refine_s8_(w.refine_s8, height / 8, width / 8, Iterations{}.s8, context_),  // same region: it reads the merges' outputs
+      refine_s8_(w.refine_s8, height / 8, width / 8, Iterations{}.s8,
+                 context_),  // same region: it reads the merges' outputs
       upsampler_(w, height / 8, width / 8, next_region(context_, "upsampler")),
       context16_(height / 16, width / 16, kContextChannels),
       flow8_(height / 8, width / 8, 2) {
@@ -49,8 +50,8 @@ void NetworkPlan::encode(dnnl::stream& stream, const Tensor& image, FrameFeature
   stream.wait();
 }
 
-const Tensor& NetworkPlan::flow(dnnl::stream& stream, const FrameFeatures& f0, const FrameFeatures& f1,
-                                int iters_s16, int iters_s8, const StageObserver* observer) {
+const Tensor& NetworkPlan::flow(dnnl::stream& stream, const FrameFeatures& f0, const FrameFeatures& f1, int iters_s16,
+                                int iters_s8, const StageObserver* observer) {
   observe(observer, "backbone_s16", 0, f0.f16);
   observe(observer, "backbone_s16", 1, f1.f16);
   observe(observer, "backbone_s8", 0, f0.f8);

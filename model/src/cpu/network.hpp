@@ -3,6 +3,7 @@
 // here and reused for every pair of that size.
 #include <dnnl.hpp>
 
+#include "dnnl/plan_context.hpp"
 #include "neuflow/model/stage_observer.hpp"
 #include "stages/convex_upsampler.hpp"
 #include "stages/cross_attention.hpp"
@@ -10,7 +11,6 @@
 #include "stages/global_matching.hpp"
 #include "stages/refinement.hpp"
 #include "stages/scale_merge.hpp"
-#include "dnnl/plan_context.hpp"
 #include "tensor.hpp"
 #include "weights.hpp"
 

@@ -53,8 +53,7 @@ class VulkanBackend final : public InferenceBackend {
   // The 8-bit frame as the device converts it in padding mode.
   static vulkan::VulkanNetwork::Frame device_frame(const ImageView& image, const FrameGeometry& g,
                                                    ChannelOrder network_order) {
-    return {image.data, image.stride,
-            {image.width, image.height, g.pad_left, g.pad_top, image.order != network_order}};
+    return {image.data, image.stride, {image.width, image.height, g.pad_left, g.pad_top, image.order != network_order}};
   }
 
   std::shared_ptr<VulkanContext> context_;

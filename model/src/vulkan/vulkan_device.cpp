@@ -68,10 +68,10 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
   }
   if (index < 0) index = pick_default(devices);
   if (index >= static_cast<int>(devices.size())) {
-    throw BackendError(BackendError::Kind::unavailable,
-                       "no Vulkan device " + std::to_string(index) + ": this machine has " +
-                           std::to_string(devices.size()) + " (0 to " + std::to_string(devices.size() - 1) +
-                           "; `neuflow devices` lists them)");
+    throw BackendError(BackendError::Kind::unavailable, "no Vulkan device " + std::to_string(index) +
+                                                            ": this machine has " + std::to_string(devices.size()) +
+                                                            " (0 to " + std::to_string(devices.size() - 1) +
+                                                            "; `neuflow devices` lists them)");
   }
   // What the shaders need: Vulkan 1.1 SPIR-V, workgroups of 256 invocations (16×16 tiles).
   VkPhysicalDeviceProperties props;
@@ -83,8 +83,9 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
   if (props.limits.maxComputeWorkGroupInvocations < 256 || props.limits.maxComputeWorkGroupSize[0] < 256 ||
       props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 8192) {
     throw BackendError(BackendError::Kind::unavailable,
-                       label + ": compute workgroups are too small for the shaders (they need 256 invocations and "
-                               "8 KiB of shared memory)");
+                       label +
+                           ": compute workgroups are too small for the shaders (they need 256 invocations and "
+                           "8 KiB of shared memory)");
   }
   const std::lock_guard lock(mutex);
   if (auto device = opened[index].lock(); device && !device->lost_) return device;
@@ -94,7 +95,9 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
 }
 
 VulkanDevice::VulkanDevice(VkPhysicalDevice physical, int index)
-    : physical_(physical), info_(describe(physical, index)), budget_(budget_from_environment()),
+    : physical_(physical),
+      info_(describe(physical, index)),
+      budget_(budget_from_environment()),
       lose_after_(lose_after_from_environment()) {
   label_ = "vulkan device " + std::to_string(index) + " (" + info_.name + ")";
   vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
@@ -223,10 +226,10 @@ void VulkanDevice::check(VkResult result, std::string_view call) const {
 }
 
 uint32_t VulkanDevice::memory_type(uint32_t allowed, Memory memory) const {
-  const VkMemoryPropertyFlags want =
-      memory == Memory::device ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
-      : memory == Memory::upload ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
-                                 : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  const VkMemoryPropertyFlags want = memory == Memory::device ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
+                                     : memory == Memory::upload
+                                         ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                         : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
   // Read-backs prefer cached memory (reads from write-combined memory are slow).
   const VkMemoryPropertyFlags prefer = memory == Memory::readback ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : 0;
   for (int pass = 0; pass < 2; ++pass) {
@@ -271,11 +274,10 @@ Buffer VulkanDevice::create_buffer(std::size_t bytes, Memory memory, const std::
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   const auto fail = [&](VkResult r, const char* call) {
     if (r == VK_SUCCESS) return;
-    throw BackendError(r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY
-                           ? BackendError::Kind::out_of_memory
-                           : BackendError::Kind::driver,
-                       label_ + ": " + call + " failed for " + what + " (" + std::to_string(bytes >> 20) +
-                           " MiB): " + result_text(r));
+    throw BackendError(
+        r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY ? BackendError::Kind::out_of_memory
+                                                                               : BackendError::Kind::driver,
+        label_ + ": " + call + " failed for " + what + " (" + std::to_string(bytes >> 20) + " MiB): " + result_text(r));
   };
   fail(vkCreateBuffer(device_, &info, nullptr, &b.buffer_), "vkCreateBuffer");
   VkMemoryRequirements req;

@@ -113,7 +113,7 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   std::mutex queue_mutex_;
   std::mutex memory_mutex_;
   std::size_t allocated_ = 0;
-  std::size_t budget_ = 0;  // 0: no budget
+  std::size_t budget_ = 0;     // 0: no budget
   long long lose_after_ = -1;  // NEUFLOW_VULKAN_LOSE_DEVICE_AFTER; -1: never
   long long submissions_ = 0;  // guarded by queue_mutex_
   std::atomic<bool> lost_{false};

@@ -80,7 +80,8 @@ Instance create_instance() {
   Instance inst;
   const VkResult r = vkCreateInstance(&info, nullptr, &inst.handle);
   if (r != VK_SUCCESS) {
-    throw BackendError(BackendError::Kind::unavailable, "Vulkan is not available: vkCreateInstance failed: " + result_text(r));
+    throw BackendError(BackendError::Kind::unavailable,
+                       "Vulkan is not available: vkCreateInstance failed: " + result_text(r));
   }
   volkLoadInstance(inst.handle);
   if (validate) {
@@ -89,7 +90,8 @@ Instance create_instance() {
     m.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     m.pfnUserCallback = on_validation_message;
-    check(vkCreateDebugUtilsMessengerEXT(inst.handle, &m, nullptr, &inst.messenger), "Vulkan", "vkCreateDebugUtilsMessengerEXT");
+    check(vkCreateDebugUtilsMessengerEXT(inst.handle, &m, nullptr, &inst.messenger), "Vulkan",
+          "vkCreateDebugUtilsMessengerEXT");
   }
   return inst;
 }
@@ -146,11 +148,21 @@ GpuDevice describe(VkPhysicalDevice device, int index) {
   d.index = index;
   d.name = props.deviceName;
   switch (props.deviceType) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: d.type = "discrete"; break;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: d.type = "integrated"; break;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: d.type = "virtual"; break;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: d.type = "cpu"; break;
-    default: d.type = "other"; break;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      d.type = "discrete";
+      break;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      d.type = "integrated";
+      break;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      d.type = "virtual";
+      break;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      d.type = "cpu";
+      break;
+    default:
+      d.type = "other";
+      break;
   }
   d.api_version = version_text(props.apiVersion);
   d.driver = "driver version " + std::to_string(props.driverVersion);

@@ -17,7 +17,7 @@ constexpr int kDim = kFeatureChannels;  // attention tokens' width
 // The attention's and matching's score blocks hold at most this many floats (32 MiB), well
 // inside lavapipe's 128 MiB per buffer, so memory stays O(L · block) at any size.
 constexpr int kScoreBlockFloats = 8 << 20;
-constexpr int kLocal = 256;        // invocations per workgroup of the element-wise shaders
+constexpr int kLocal = 256;  // invocations per workgroup of the element-wise shaders
 
 // An activation code of shaders/params/activation.h.
 using Act = int;
@@ -31,9 +31,8 @@ uint32_t groups(long count, long per_group) {
 uint32_t tiles(long count, const char* what) {
   const long n = (count + 63) / 64;
   if (n > 65535) {
-    throw BackendError(BackendError::Kind::unavailable,
-                       std::string("a model size too large for one dispatch of ") + what +
-                           ": choose a smaller model-width/model-height");
+    throw BackendError(BackendError::Kind::unavailable, std::string("a model size too large for one dispatch of ") +
+                                                            what + ": choose a smaller model-width/model-height");
   }
   return static_cast<uint32_t>(std::max<long>(n, 1));
 }
@@ -155,8 +154,10 @@ class VulkanNetwork::Recorder {
   // out = act(conv(in) + bias (+ addend)); out.c must be the layer's output channels.
   void conv(const DeviceConv& w, const View& in, int stride, int pad, Act act, const View& out,
             const View* addend = nullptr) {
-    const Conv2dParams p{in.c, in.h, in.w, in.offset(), out.c, out.h, out.w, out.offset(), w.kernel, stride, pad, act,
-               w.weight, w.bias, addend ? addend->offset() : -1, 1.f};
+    const Conv2dParams p{in.c,  in.h,  in.w,         in.offset(), out.c,
+                         out.h, out.w, out.offset(), w.kernel,    stride,
+                         pad,   act,   w.weight,     w.bias,      addend ? addend->offset() : -1,
+                         1.f};
     dispatch<Shader::conv2d>({&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, p,
                              tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
   }
@@ -164,8 +165,11 @@ class VulkanNetwork::Recorder {
   // Token lists [features][tokens]: out = act(W · in + b).
   void linear(const DeviceLinear& w, const Buffer& in, int in_off, const Buffer& out, int out_off, int tokens,
               Act act = kActNone) {
-    const MatmulParams p{w.out_features, tokens, w.in_features, w.weight, w.in_features, 1, in_off, tokens, 1,
-                 out_off, tokens, 1, w.bias, act, 1.f};
+    const MatmulParams p{w.out_features, tokens,        w.in_features,
+                         w.weight,       w.in_features, 1,
+                         in_off,         tokens,        1,
+                         out_off,        tokens,        1,
+                         w.bias,         act,           1.f};
     dispatch<Shader::matmul>({&net_.weights_->buffer, &in, &out, nullptr}, p, tiles(tokens, "attention"),
                              tiles(w.out_features, "attention"));
   }
@@ -244,15 +248,16 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   const std::size_t l = tokens_;
   using M = VulkanDevice::Memory;
   const auto make = [&](std::size_t values, const char* what, M memory = M::device) {
-    return device_.create_buffer(values * elem_, memory, std::string(what) + " at " + std::to_string(width) + "x" +
-                                                             std::to_string(height));
+    return device_.create_buffer(values * elem_, memory,
+                                 std::string(what) + " at " + std::to_string(width) + "x" + std::to_string(height));
   };
   dummy_ = make(4, "a placeholder binding");
   zeros_ = make(kHiddenChannels * hw8 + 2, "zeros");
   for (std::size_t e = 0; e < ring_.size(); ++e) {
     ring_[e].upload = make(3 * hw, "the frame upload", M::upload);
     // Entry 0 also serves the observer, which reads whole stages back.
-    ring_[e].readback = make(e == 0 ? std::max(kFeatureChannels * hw8, 2 * hw) : 2 * hw, "the read-back buffer", M::readback);
+    ring_[e].readback =
+        make(e == 0 ? std::max(kFeatureChannels * hw8, 2 * hw) : 2 * hw, "the read-back buffer", M::readback);
   }
   input_ = make(3 * hw, "the input frame");
   half_ = make(3 * hw / 4, "the 1/2 frame");
@@ -352,10 +357,10 @@ void VulkanNetwork::initialise_constants() {
   for (int y = 0; y < h16_; ++y) {
     for (int x = 0; x < w16_; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * w16_ + x;
-      c[p] = static_cast<float>(y) - static_cast<float>(h16_) / 2.f;            // f16 position channel y
-      c[l + p] = static_cast<float>(x) - static_cast<float>(w16_) / 2.f;        // f16 position channel x
-      c[2 * l + p] = static_cast<float>(x);                                     // grid x
-      c[3 * l + p] = static_cast<float>(y);                                     // grid y
+      c[p] = static_cast<float>(y) - static_cast<float>(h16_) / 2.f;      // f16 position channel y
+      c[l + p] = static_cast<float>(x) - static_cast<float>(w16_) / 2.f;  // f16 position channel x
+      c[2 * l + p] = static_cast<float>(x);                               // grid x
+      c[3 * l + p] = static_cast<float>(y);                               // grid y
     }
   }
   Buffer staging = device_.create_buffer(c.size() * elem_, VulkanDevice::Memory::upload, "constants");
@@ -369,7 +374,8 @@ void VulkanNetwork::initialise_constants() {
   }
   const VkBufferCopy grid{2 * l * e, 0, 2 * l * e};
   vkCmdCopyBuffer(cb, staging.handle(), grid_.handle(), 1, &grid);
-  const VkBufferCopy radius16{4 * l * e, kContextChannels * l * e, l * e}, radius8{4 * l * e, kContextChannels * hw8 * e, hw8 * e};
+  const VkBufferCopy radius16{4 * l * e, kContextChannels * l * e, l * e},
+      radius8{4 * l * e, kContextChannels * hw8 * e, hw8 * e};
   vkCmdCopyBuffer(cb, staging.handle(), refine16_.constant_in.handle(), 1, &radius16);
   vkCmdCopyBuffer(cb, staging.handle(), refine8_.constant_in.handle(), 1, &radius8);
   vkCmdFillBuffer(cb, zeros_.handle(), 0, VK_WHOLE_SIZE, 0);
@@ -721,7 +727,8 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   r.observe("cross_attn_s16", 1, att1);
 
   // Global matching: softmax(F0 F1^T / sqrt(128)) G - G, in blocks of rows.
-  const View feat0 = att0.channels(kContextChannels, kMatchingChannels), feat1 = att1.channels(kContextChannels, kMatchingChannels);
+  const View feat0 = att0.channels(kContextChannels, kMatchingChannels),
+             feat1 = att1.channels(kContextChannels, kMatchingChannels);
   const float alpha = 1.f / std::sqrt(static_cast<float>(kMatchingChannels));
   for (int r0 = 0; r0 < l; r0 += block_rows_) {
     const int n = std::min(block_rows_, l - r0);
@@ -736,7 +743,8 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   r.observe("global_matching_flow", 0, flow16);
 
   // 1/16 refinement with ctx16 = relu(context of frame 0).
-  r.resample(att0.channels(0, kContextChannels), View{&refine16_.constant_in, 0, kContextChannels, h16_, w16_}, 1, true, 1.f);
+  r.resample(att0.channels(0, kContextChannels), View{&refine16_.constant_in, 0, kContextChannels, h16_, w16_}, 1, true,
+             1.f);
   record_refinement(r, wt.refine_s16, refine16_, feat0, feat1, flow16, iterations.s16, "s16");
 
   // 1/16 → 1/8.
@@ -746,7 +754,8 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   for (int f = 0; f < 2; ++f) {
     const View in{&feature_in_, 0, 2 * kMatchingChannels, h8_, w8_};
     r.copy(View{&frames[f]->f8, kContextChannels, kMatchingChannels, h8_, w8_}, in.channels(0, kMatchingChannels));
-    r.resample(View{&attended_[f], kContextChannels, kMatchingChannels, h16_, w16_}, in.channels(kMatchingChannels, kMatchingChannels), 2, false, 1.f);
+    r.resample(View{&attended_[f], kContextChannels, kMatchingChannels, h16_, w16_},
+               in.channels(kMatchingChannels, kMatchingChannels), 2, false, 1.f);
     const View tmp{&merge_tmp_, 0, kMatchingChannels, h8_, w8_};
     r.conv(wt.merge_s8_0, in, 1, 1, kActGelu, tmp);
     r.conv(wt.merge_s8_2, tmp, 1, 1, kActNone, View{&features8_[f], 0, kMatchingChannels, h8_, w8_});
@@ -770,7 +779,8 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   const View up_in{&upsample_in_, 0, 130, h8_, w8_};
   r.copy(flow8, up_in.channels(0, 2));
   r.copy(View{&s0.up, 0, 128, h8_, w8_}, up_in.channels(2, 128));
-  const View u1{&upsample1_, 0, 256, h8_, w8_}, u2{&upsample2_, 0, 512, h8_, w8_}, mask{&mask_, 0, kUpsampleMaskChannels, h8_, w8_};
+  const View u1{&upsample1_, 0, 256, h8_, w8_}, u2{&upsample2_, 0, 512, h8_, w8_},
+      mask{&mask_, 0, kUpsampleMaskChannels, h8_, w8_};
   r.conv(wt.upsample_conv1, up_in, 1, 1, kActRelu, u1);
   r.conv(wt.upsample_conv2, u1, 1, 1, kActRelu, u2);
   r.conv(wt.upsample_conv3, u2, 1, 0, kActNone, mask);

@@ -11,10 +11,10 @@
 // submission without waiting, so the host uploads frame N+1 (and reads back pair N-1) while
 // the device computes pair N. The device runs submissions in order (each pass begins with a
 // barrier), so only what the host touches needs a copy per ring entry.
-#include <deque>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -22,9 +22,9 @@
 #include <utility>
 #include <vector>
 
+#include "inference_backend.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
-#include "inference_backend.hpp"
 #include "tensor.hpp"
 #include "vulkan/device_weights.hpp"
 
@@ -77,7 +77,7 @@ class VulkanNetwork {
   // Ring entries: passes started and not yet finished.
   static constexpr int kRing = 2;
   struct Step {
-    const Frame* frame = nullptr;  // the frame in 8 bits, or
+    const Frame* frame = nullptr;   // the frame in 8 bits, or
     const Tensor* image = nullptr;  // converted as encode(Tensor) takes it
     int slot = 0;                   // where its features go
     int previous = -1;              // the slot of the frame before it; -1: no pair
@@ -143,8 +143,8 @@ class VulkanNetwork {
 
   std::shared_ptr<const DeviceWeights> weights_;
   VulkanDevice& device_;
-  bool fp16_;          // tensors stored as float16_t
-  std::size_t elem_;   // bytes per stored value: 4 or 2
+  bool fp16_;         // tensors stored as float16_t
+  std::size_t elem_;  // bytes per stored value: 4 or 2
   int height_, width_, h8_, w8_, h16_, w16_, tokens_, block_rows_;
 
   Buffer dummy_, zeros_;

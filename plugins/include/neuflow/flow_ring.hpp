@@ -88,20 +88,20 @@ enum class SegmentState : std::uint32_t {
 // At offset 0 of the segment. Every field but `state` and `flows_published` is written once,
 // before `state` becomes live, and never changes afterwards.
 struct RingHeader {
-  char magic[8];                      // "NFLOWRNG"
-  std::uint32_t version;              // kLayoutVersion
-  std::uint32_t header_size;          // offset of slot 0
-  std::uint32_t slot_count;           // N
-  std::uint32_t slot_header_size;     // offset of the flow data inside a slot
-  std::uint64_t slot_stride;          // bytes from one slot to the next
-  std::uint32_t grid_width;           // every flow in this segment has this grid size
+  char magic[8];                   // "NFLOWRNG"
+  std::uint32_t version;           // kLayoutVersion
+  std::uint32_t header_size;       // offset of slot 0
+  std::uint32_t slot_count;        // N
+  std::uint32_t slot_header_size;  // offset of the flow data inside a slot
+  std::uint64_t slot_stride;       // bytes from one slot to the next
+  std::uint32_t grid_width;        // every flow in this segment has this grid size
   std::uint32_t grid_height;
-  std::uint32_t value_layout;         // kValueLayoutF32UV
-  std::uint32_t state;                // SegmentState, atomic
-  std::uint64_t generation;           // differs between successive segments under one name
-  std::uint64_t flows_published;      // atomic: sequence number of the newest complete flow, 0 = none
-  std::uint64_t segment_size;         // bytes of the whole segment
-  std::uint64_t data_bytes;           // bytes of flow data in each slot: grid_width * grid_height * 8
+  std::uint32_t value_layout;     // kValueLayoutF32UV
+  std::uint32_t state;            // SegmentState, atomic
+  std::uint64_t generation;       // differs between successive segments under one name
+  std::uint64_t flows_published;  // atomic: sequence number of the newest complete flow, 0 = none
+  std::uint64_t segment_size;     // bytes of the whole segment
+  std::uint64_t data_bytes;       // bytes of flow data in each slot: grid_width * grid_height * 8
   std::uint32_t writer_pid;
   std::uint32_t reserved0;
   std::uint64_t created_realtime_ns;  // CLOCK_REALTIME when the segment was created
@@ -110,22 +110,22 @@ struct RingHeader {
 
 // At the start of each slot, followed by the flow data at slot_header_size.
 struct SlotHeader {
-  std::uint64_t sequence;             // atomic seqlock word: 2n-1 while flow n is written, 2n once complete
-  std::uint64_t from_frame;           // frame numbers of the two frames (counted by the `neuflow` element)
+  std::uint64_t sequence;    // atomic seqlock word: 2n-1 while flow n is written, 2n once complete
+  std::uint64_t from_frame;  // frame numbers of the two frames (counted by the `neuflow` element)
   std::uint64_t to_frame;
-  std::uint64_t from_pts_ns;          // their timestamps, kNoTimestamp when unknown
+  std::uint64_t from_pts_ns;  // their timestamps, kNoTimestamp when unknown
   std::uint64_t to_pts_ns;
   std::uint64_t inference_ns;         // wall time of the computation
   std::uint64_t written_realtime_ns;  // CLOCK_REALTIME when the writer published the flow
   std::uint32_t grid_width;           // equal to the header's
   std::uint32_t grid_height;
-  std::uint32_t frame_width;          // the frame the grid covers
+  std::uint32_t frame_width;  // the frame the grid covers
   std::uint32_t frame_height;
-  std::uint32_t model_width;          // the size the network ran at
+  std::uint32_t model_width;  // the size the network ran at
   std::uint32_t model_height;
-  std::uint32_t iters_s16;            // refinement iterations at 1/16 and 1/8
+  std::uint32_t iters_s16;  // refinement iterations at 1/16 and 1/8
   std::uint32_t iters_s8;
-  std::uint32_t crc32;                // CRC-32 (zlib's, polynomial 0xEDB88320 reflected) of the data bytes
+  std::uint32_t crc32;  // CRC-32 (zlib's, polynomial 0xEDB88320 reflected) of the data bytes
   std::uint32_t reserved0;
   std::uint64_t data_bytes;
   std::uint8_t reserved[24];
@@ -194,8 +194,8 @@ inline std::uint32_t crc32(const void *data, std::size_t size, std::uint32_t crc
     std::memcpy(&lo, p, 4);
     std::memcpy(&hi, p + 4, 4);
     lo ^= crc;
-    crc = t[7][lo & 0xffu] ^ t[6][(lo >> 8) & 0xffu] ^ t[5][(lo >> 16) & 0xffu] ^ t[4][lo >> 24] ^
-          t[3][hi & 0xffu] ^ t[2][(hi >> 8) & 0xffu] ^ t[1][(hi >> 16) & 0xffu] ^ t[0][hi >> 24];
+    crc = t[7][lo & 0xffu] ^ t[6][(lo >> 8) & 0xffu] ^ t[5][(lo >> 16) & 0xffu] ^ t[4][lo >> 24] ^ t[3][hi & 0xffu] ^
+          t[2][(hi >> 8) & 0xffu] ^ t[1][(hi >> 16) & 0xffu] ^ t[0][hi >> 24];
   }
   for (; size > 0; --size) crc = t[0][(crc ^ *p++) & 0xffu] ^ (crc >> 8);
   return ~crc;
@@ -220,7 +220,8 @@ struct FlowInfo {
 
 // Whether `uv` (as filled by a read) matches the checksum the writer stored.
 inline bool verify(std::span<const float> uv, const FlowInfo &info) {
-  return uv.size_bytes() >= info.data_bytes && crc32(uv.data(), static_cast<std::size_t>(info.data_bytes)) == info.crc32;
+  return uv.size_bytes() >= info.data_bytes &&
+         crc32(uv.data(), static_cast<std::size_t>(info.data_bytes)) == info.crc32;
 }
 
 enum class ReadStatus {
@@ -232,10 +233,14 @@ enum class ReadStatus {
 
 inline const char *to_string(ReadStatus s) {
   switch (s) {
-    case ReadStatus::ok: return "ok";
-    case ReadStatus::not_published: return "not published";
-    case ReadStatus::overwritten: return "overwritten";
-    case ReadStatus::torn: return "torn";
+    case ReadStatus::ok:
+      return "ok";
+    case ReadStatus::not_published:
+      return "not published";
+    case ReadStatus::overwritten:
+      return "overwritten";
+    case ReadStatus::torn:
+      return "torn";
   }
   return "?";
 }
@@ -321,8 +326,7 @@ class FlowRingReader {
                                   " floats, a flow needs " + std::to_string(values_per_flow()));
     }
     if (sequence == 0) return ReadStatus::not_published;
-    const std::byte *slot =
-        base_ + header_.header_size + ((sequence - 1) % header_.slot_count) * header_.slot_stride;
+    const std::byte *slot = base_ + header_.header_size + ((sequence - 1) % header_.slot_count) * header_.slot_stride;
     auto word = atomic_field<std::uint64_t>(slot, kSequenceOffset);
     const std::uint64_t wanted = 2 * sequence;
     for (int attempt = 0; attempt < max_attempts; ++attempt) {
@@ -372,7 +376,8 @@ class FlowRingReader {
     const int fd = ::shm_open(name_.c_str(), O_RDONLY | O_CLOEXEC, 0);
     if (fd < 0) {
       const int err = errno;
-      if (err == ENOENT) fail(RingError::Kind::no_such_segment, "no such shared-memory segment (is the writer running?)");
+      if (err == ENOENT)
+        fail(RingError::Kind::no_such_segment, "no such shared-memory segment (is the writer running?)");
       if (err == EACCES) {
         fail(RingError::Kind::permission_denied,
              "permission denied (the writer's shm-mode is 0640 by default: run the reader as the writer's user or "
@@ -437,8 +442,8 @@ class FlowRingReader {
     ok = ok && h.header_size <= size && h.slot_stride <= (size - h.header_size) / h.slot_count;
     if (!ok) {
       fail(RingError::Kind::bad_layout,
-           "inconsistent header (grid " + std::to_string(h.grid_width) + "x" + std::to_string(h.grid_height) +
-               ", " + std::to_string(h.slot_count) + " slots of " + std::to_string(h.slot_stride) + " bytes, value layout " +
+           "inconsistent header (grid " + std::to_string(h.grid_width) + "x" + std::to_string(h.grid_height) + ", " +
+               std::to_string(h.slot_count) + " slots of " + std::to_string(h.slot_stride) + " bytes, value layout " +
                std::to_string(h.value_layout) + ", segment of " + std::to_string(size) + " bytes)");
     }
   }

@@ -76,7 +76,8 @@ std::vector<std::vector<std::string>> read_csv(const fs::path& path) {
 double max_difference(const flow::FlowField& a, const flow::FlowField& b) {
   if (a.width != b.width || a.height != b.height) return INFINITY;
   double worst = 0;
-  for (std::size_t i = 0; i < a.uv.size(); ++i) worst = std::max(worst, static_cast<double>(std::abs(a.uv[i] - b.uv[i])));
+  for (std::size_t i = 0; i < a.uv.size(); ++i)
+    worst = std::max(worst, static_cast<double>(std::abs(a.uv[i] - b.uv[i])));
   return worst;
 }
 
@@ -94,8 +95,8 @@ class ConvertCli : public ::testing::Test {
   }
 
   // The first camera frames, downscaled, saved under `names` in `folder`.
-  std::vector<cv::Mat> make_frames(const fs::path& folder, const std::vector<std::string>& names,
-                                   int width = kWidth, int height = kHeight) {
+  std::vector<cv::Mat> make_frames(const fs::path& folder, const std::vector<std::string>& names, int width = kWidth,
+                                   int height = kHeight) {
     fs::create_directories(folder);
     std::vector<cv::Mat> images;
     for (std::size_t i = 0; i < names.size(); ++i) {
@@ -109,8 +110,8 @@ class ConvertCli : public ::testing::Test {
   }
 
   std::vector<std::string> convert_args(const fs::path& output) const {
-    return {"convert", "-m", checkpoint_.string(), "--iters-s16", "1", "--iters-s8", "1", "--threads", "1",
-            "-o", output.string()};
+    return {"convert", "-m", checkpoint_.string(), "--iters-s16", "1", "--iters-s8", "1", "--threads",
+            "1",       "-o", output.string()};
   }
 
   RunResult convert(const fs::path& output, const std::vector<std::string>& more) const {
@@ -220,7 +221,8 @@ TEST_F(ConvertCli, ResumeRecomputesOnlyMissingOrIncompleteFlows) {
   const auto full = convert(dir / "out", {(dir / "seq").string(), "--format", "npy"});
   ASSERT_EQ(full.exit_code, 0) << full.output;
   std::vector<flow::FlowField> original;
-  for (const char* stem : {"f1", "f2", "f3", "f4"}) original.push_back(flow::read_flow(out / (std::string(stem) + ".npy")));
+  for (const char* stem : {"f1", "f2", "f3", "f4"})
+    original.push_back(flow::read_flow(out / (std::string(stem) + ".npy")));
 
   fs::remove(out / "f2.npy");
   fs::resize_file(out / "f3.npy", fs::file_size(out / "f3.npy") / 2);  // an interrupted write
@@ -232,7 +234,9 @@ TEST_F(ConvertCli, ResumeRecomputesOnlyMissingOrIncompleteFlows) {
   const char* stems[] = {"f1", "f2", "f3", "f4"};
   for (int i = 0; i < 4; ++i) {
     // f2 follows the kept f1, so the session restarts there; the result must not change.
-    EXPECT_LT(max_difference(flow::read_flow(out / (std::string(stems[i]) + ".npy")), original[static_cast<std::size_t>(i)]), 1e-5)
+    EXPECT_LT(
+        max_difference(flow::read_flow(out / (std::string(stems[i]) + ".npy")), original[static_cast<std::size_t>(i)]),
+        1e-5)
         << stems[i];
   }
   EXPECT_EQ(read_csv(out / "index.csv").size(), 5u) << "the index lists kept pairs too";
@@ -327,7 +331,8 @@ TEST_F(ConvertCli, KittiFlowsAndPngRenderings) {
 TEST_F(ConvertCli, BgrChannelOrderFeedsTheNetworkSwappedChannels) {
   TempDir dir;
   auto images = make_frames(dir.path(), {"a.png", "b.png"});
-  const auto result = convert(dir / "out", {(dir / "a.png").string(), (dir / "b.png").string(), "--channel-order", "bgr"});
+  const auto result =
+      convert(dir / "out", {(dir / "a.png").string(), (dir / "b.png").string(), "--channel-order", "bgr"});
   ASSERT_EQ(result.exit_code, 0) << result.output;
   for (auto& image : images) cv::cvtColor(image, image, cv::COLOR_BGR2RGB);
   // The reference reads the swapped images as BGR, so the network sees the original BGR as RGB.
@@ -347,8 +352,8 @@ TEST_F(ConvertCli, SingleFrameAndEmptyFolderFail) {
 TEST_F(ConvertCli, MissingCheckpointFailsBeforeAnyInput) {
   TempDir dir;
   make_frames(dir / "seq", {"a.png", "b.png"});
-  const auto result = run_neuflow({"convert", "-m", (dir / "none.pth").string(), "-o", (dir / "out").string(),
-                                   (dir / "seq").string()});
+  const auto result =
+      run_neuflow({"convert", "-m", (dir / "none.pth").string(), "-o", (dir / "out").string(), (dir / "seq").string()});
   EXPECT_EQ(result.exit_code, 66) << result.output;
   EXPECT_FALSE(fs::exists(dir / "out"));
 }
@@ -442,15 +447,17 @@ TEST_F(ConvertCli, FrameRangesTogetherWriteWhatOneRunWrites) {
 
 TEST(ConvertFrameRate, ImagesNamedByTheirCaptureTimeGiveTheirRate) {
   // The fixture camera's names: nanoseconds since the epoch, about 66.7 ms apart.
-  const auto rate = rate_from_timestamps({"1684437740861809471", "1684437740927818192", "1684437740994402386",
-                                          "1684437741060823325"});
+  const auto rate = rate_from_timestamps(
+      {"1684437740861809471", "1684437740927818192", "1684437740994402386", "1684437741060823325"});
   ASSERT_TRUE(rate.known());
   EXPECT_NEAR(rate.fps(), 15.1, 0.05);
   EXPECT_NEAR(rate_from_timestamps({"1700000000000", "1700000000040", "1700000000080"}).fps(), 25.0, 1e-9);  // ms
-  EXPECT_NEAR(rate_from_timestamps({"1700000000", "1700000002"}).fps(), 0.5, 1e-9);                        // s
-  for (const std::vector<std::string>& none :
-       {std::vector<std::string>{"frame_001", "frame_002"}, {"0001", "0002"}, {"1684437740861809471"},
-        {"1684437740927818192", "1684437740861809471"}, {"1700000000000", "17000000000400"}}) {
+  EXPECT_NEAR(rate_from_timestamps({"1700000000", "1700000002"}).fps(), 0.5, 1e-9);                          // s
+  for (const std::vector<std::string>& none : {std::vector<std::string>{"frame_001", "frame_002"},
+                                               {"0001", "0002"},
+                                               {"1684437740861809471"},
+                                               {"1684437740927818192", "1684437740861809471"},
+                                               {"1700000000000", "17000000000400"}}) {
     EXPECT_FALSE(rate_from_timestamps(none).known()) << none.front();
   }
 }

@@ -17,7 +17,8 @@ TEST(NaturalSort, NumbersCompareByValue) {
 }
 
 TEST(NaturalSort, SortsAShuffledSequence) {
-  std::vector<std::string> names = {"frame10.png", "frame1.png", "frame100.png", "frame2.png", "frame11.png", "frame3.png"};
+  std::vector<std::string> names = {"frame10.png", "frame1.png",  "frame100.png",
+                                    "frame2.png",  "frame11.png", "frame3.png"};
   std::sort(names.begin(), names.end(), [](const auto& a, const auto& b) { return natural_less(a, b); });
   EXPECT_EQ(names, (std::vector<std::string>{"frame1.png", "frame2.png", "frame3.png", "frame10.png", "frame11.png",
                                              "frame100.png"}));

@@ -180,8 +180,8 @@ TEST(EvalPredictions, SintelBreaksDownByScene) {
   EXPECT_EQ(r.sequences[0].summary.epe, 0.0);
   EXPECT_EQ(r.sequences[1].name, "market_5");
   EXPECT_NEAR(r.sequences[1].summary.epe, 5.0, 1e-5);
-  const double weight = static_cast<double>(r.sequences[1].summary.valid_pixels) /
-                        static_cast<double>(r.summary.valid_pixels);
+  const double weight =
+      static_cast<double>(r.sequences[1].summary.valid_pixels) / static_cast<double>(r.summary.valid_pixels);
   EXPECT_NEAR(r.summary.epe, 5.0 * weight, 1e-5);
 }
 

@@ -52,7 +52,7 @@ TEST(EvalPadding, PadImageReplicatesTheEdges) {
   ASSERT_EQ(padded.cols, 6);
   ASSERT_EQ(padded.rows, 3);
   const cv::Mat expected = (cv::Mat_<unsigned char>(3, 6) << 1, 1, 2, 3, 3, 3,  //
-                            4, 4, 5, 6, 6, 6,                                 //
+                            4, 4, 5, 6, 6, 6,                                   //
                             4, 4, 5, 6, 6, 6);
   EXPECT_EQ(cv::countNonZero(padded != expected), 0);
 }

@@ -100,9 +100,9 @@ assert s[1]["epe"] == 2.375 and s[1]["pairs"] == 1
   predictions.root = "/data/KITTI";
   predictions.predictions = "/out/pred";
   predictions.max_pairs = 5;
-  EXPECT_EQ(run_python(format_json(predictions, {sample_set("kitti", Dataset::kitti, Aggregation::mean_of_images)},
-                                   false),
-                       R"(
+  EXPECT_EQ(
+      run_python(format_json(predictions, {sample_set("kitti", Dataset::kitti, Aggregation::mean_of_images)}, false),
+                 R"(
 import json, sys
 d = json.load(open(sys.argv[1]))
 assert d["source"] == "predictions" and d["predictions"] == "/out/pred", d
@@ -111,7 +111,7 @@ assert d["max_pairs"] == 5
 r = d["results"][0]
 assert r["epe_aggregation"] == "images" and "sequences" not in r, r
 )"),
-            0);
+      0);
 }
 
 }  // namespace

@@ -15,12 +15,12 @@ namespace neuflow::cli {
 
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitFailure = 1;
-inline constexpr int kExitUsage = 64;       // EX_USAGE: the command line is wrong (CLI11's own codes are not used)
-inline constexpr int kExitDataError = 65;   // EX_DATAERR: an input file is malformed
-inline constexpr int kExitNoInput = 66;     // EX_NOINPUT: an input file is missing or unreadable
+inline constexpr int kExitUsage = 64;        // EX_USAGE: the command line is wrong (CLI11's own codes are not used)
+inline constexpr int kExitDataError = 65;    // EX_DATAERR: an input file is malformed
+inline constexpr int kExitNoInput = 66;      // EX_NOINPUT: an input file is missing or unreadable
 inline constexpr int kExitUnavailable = 69;  // EX_UNAVAILABLE: the GPU backend (Vulkan, its device) failed
-inline constexpr int kExitCantCreate = 73;  // EX_CANTCREAT: an output could not be written
-inline constexpr int kExitConfig = 78;      // EX_CONFIG: the environment's settings are wrong (NEUFLOW_CONV)
+inline constexpr int kExitCantCreate = 73;   // EX_CANTCREAT: an output could not be written
+inline constexpr int kExitConfig = 78;       // EX_CONFIG: the environment's settings are wrong (NEUFLOW_CONV)
 
 // Thrown from a subcommand's callback: main prints "neuflow <sub>: <message>" and exits
 // with exit_code.

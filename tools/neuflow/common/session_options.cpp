@@ -46,9 +46,7 @@ void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions 
                   "CPU), cpu, or vulkan (any Vulkan device, software ones included)")
       ->check(CLI::IsMember({"auto", "cpu", "vulkan"}))
       ->capture_default_str();
-  command
-      .add_option("--device", o.device,
-                  "Vulkan device index, as `neuflow devices` lists them (-1: the first GPU)")
+  command.add_option("--device", o.device, "Vulkan device index, as `neuflow devices` lists them (-1: the first GPU)")
       ->capture_default_str()
       ->check(CLI::Range(-1, L::max_device));
   command
@@ -82,8 +80,9 @@ model::SessionOptions session_options(const SessionArgs& args) {
       throw CommandError(kExitUsage, "--size wants WIDTHxHEIGHT (multiples of 16), got '" + args.size_alias + "'");
     }
   }
-  options.network_order = args.bgr_alias ? model::ChannelOrder::bgr
-                                         : model::parse_channel_order(args.channel_order).value_or(model::ChannelOrder::rgb);
+  options.network_order = args.bgr_alias
+                              ? model::ChannelOrder::bgr
+                              : model::parse_channel_order(args.channel_order).value_or(model::ChannelOrder::rgb);
   options.backend = model::parse_backend(args.backend).value_or(model::Backend::automatic);
   options.precision = model::parse_precision(args.precision).value_or(model::Precision::fp32);
   if (auto problem = model::check_session_options(options)) throw CommandError(kExitUsage, "--" + *problem);

@@ -3,9 +3,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
-#include <cstdio>
-#include <cmath>
 #include <cctype>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <utility>
@@ -35,7 +35,8 @@ class ImageSequence final : public FrameSource {
     if (next_ >= files_.size()) return std::nullopt;
     const ImageFile& file = files_[next_];
     std::error_code ec;
-    if (!fs::is_regular_file(file.path, ec)) throw InputError(kExitNoInput, file.path.string() + ": no such image file");
+    if (!fs::is_regular_file(file.path, ec))
+      throw InputError(kExitNoInput, file.path.string() + ": no such image file");
     Frame frame;
     frame.pixels = cv::imread(file.path.string(), cv::IMREAD_COLOR);
     if (frame.pixels.empty()) {
@@ -119,8 +120,9 @@ std::vector<fs::path> list_images(const fs::path& folder) {
       images.push_back(it->path());
     }
   }
-  std::sort(images.begin(), images.end(),
-            [](const fs::path& a, const fs::path& b) { return natural_less(a.filename().string(), b.filename().string()); });
+  std::sort(images.begin(), images.end(), [](const fs::path& a, const fs::path& b) {
+    return natural_less(a.filename().string(), b.filename().string());
+  });
   return images;
 }
 
@@ -131,11 +133,20 @@ pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems) 
   const std::size_t digits = stems.front().size();
   double unit = 0;  // seconds per tick
   switch (digits) {
-    case 10: unit = 1; break;
-    case 13: unit = 1e-3; break;
-    case 16: unit = 1e-6; break;
-    case 19: unit = 1e-9; break;
-    default: return {};
+    case 10:
+      unit = 1;
+      break;
+    case 13:
+      unit = 1e-3;
+      break;
+    case 16:
+      unit = 1e-6;
+      break;
+    case 19:
+      unit = 1e-9;
+      break;
+    default:
+      return {};
   }
   std::uint64_t previous = 0;
   std::uint64_t first = 0;
@@ -168,7 +179,8 @@ std::unique_ptr<FrameSource> open_frames(const InputSpec& input) {
       }
       return std::make_unique<ImageSequence>(name_images(images));
     }
-    case InputKind::video: return std::make_unique<VideoFrames>(input.paths[0]);
+    case InputKind::video:
+      return std::make_unique<VideoFrames>(input.paths[0]);
   }
   throw InputError(kExitFailure, input.label + ": unknown kind of input");
 }

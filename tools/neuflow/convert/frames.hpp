@@ -16,11 +16,11 @@
 namespace neuflow::cli {
 
 struct Frame {
-  cv::Mat pixels;                    // 8-bit, 3 channels
-  model::ChannelOrder data_order;    // how `pixels` holds them (OpenCV: BGR, GStreamer: RGB)
-  std::int64_t number = 0;           // 0-based position in the input
+  cv::Mat pixels;                      // 8-bit, 3 channels
+  model::ChannelOrder data_order;      // how `pixels` holds them (OpenCV: BGR, GStreamer: RGB)
+  std::int64_t number = 0;             // 0-based position in the input
   std::optional<std::int64_t> pts_ns;  // video frames' presentation time
-  std::string source;  // the image's file name; empty for video frames
+  std::string source;                  // the image's file name; empty for video frames
   // Base name of the outputs of the pair that starts at this frame: the image's stem (its
   // whole file name where two images of the folder share a stem), or frame_000123 for video.
   std::string output_stem;

@@ -18,9 +18,8 @@ namespace {
 bool is_uri(const std::string& s) {
   const auto scheme_end = s.find("://");
   return scheme_end != std::string::npos && scheme_end > 0 &&
-         std::all_of(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(scheme_end), [](unsigned char c) {
-           return std::isalnum(c) || c == '+' || c == '-' || c == '.';
-         });
+         std::all_of(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(scheme_end),
+                     [](unsigned char c) { return std::isalnum(c) || c == '+' || c == '-' || c == '.'; });
 }
 
 // The name a path is known by: "frames/" and "frames" are both "frames", "." is the
@@ -81,7 +80,8 @@ InputSpec single(const std::string& path, bool lone_image) {
   if (!fs::exists(status)) {
     spec.rejected = InputError(kExitNoInput, "no such file or folder");
   } else if (lone_image) {
-    spec.rejected = InputError(kExitFailure, "a single image has no pair: give two images (or --pair A B), or a folder of frames");
+    spec.rejected =
+        InputError(kExitFailure, "a single image has no pair: give two images (or --pair A B), or a folder of frames");
   }
   return spec;
 }
@@ -89,10 +89,11 @@ InputSpec single(const std::string& path, bool lone_image) {
 }  // namespace
 
 bool has_image_extension(const std::string& path) {
-  static constexpr std::array<std::string_view, 11> kExtensions = {".png", ".jpg",  ".jpeg", ".bmp", ".tif", ".tiff",
+  static constexpr std::array<std::string_view, 11> kExtensions = {".png",  ".jpg", ".jpeg", ".bmp", ".tif", ".tiff",
                                                                    ".webp", ".ppm", ".pgm",  ".pnm", ".jpe"};
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return std::find(kExtensions.begin(), kExtensions.end(), ext) != kExtensions.end();
 }
 
@@ -101,14 +102,17 @@ std::vector<InputSpec> plan_inputs(const std::vector<std::string>& positional,
   std::vector<InputSpec> specs;
   for (const auto& [a, b] : pairs) specs.push_back(image_pair(a, b));
 
-  const auto is_image = [](const std::string& p) { return !is_uri(p) && !fs::is_directory(p) && has_image_extension(p); };
+  const auto is_image = [](const std::string& p) {
+    return !is_uri(p) && !fs::is_directory(p) && has_image_extension(p);
+  };
   const auto images = std::count_if(positional.begin(), positional.end(), is_image);
   bool pair_added = false;
   for (const auto& path : positional) {
     if (!is_image(path)) {
       specs.push_back(single(path, false));
     } else if (images == 2 && !pair_added) {
-      const auto second = std::find_if(std::find(positional.begin(), positional.end(), path) + 1, positional.end(), is_image);
+      const auto second =
+          std::find_if(std::find(positional.begin(), positional.end(), path) + 1, positional.end(), is_image);
       specs.push_back(image_pair(path, *second));
       pair_added = true;
     } else if (images != 2) {

@@ -16,8 +16,8 @@ struct InputSpec {
   InputKind kind = InputKind::video;
   // image_pair: the two images; image_folder: the folder; video: the file or URI.
   std::vector<std::string> paths;
-  std::string label;        // how messages name the input: as given on the command line
-  std::string output_name;  // its sub-folder of the output folder, unique among the inputs
+  std::string label;                   // how messages name the input: as given on the command line
+  std::string output_name;             // its sub-folder of the output folder, unique among the inputs
   std::optional<InputError> rejected;  // set when the input cannot be converted at all
 };
 

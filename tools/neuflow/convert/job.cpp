@@ -29,9 +29,12 @@ constexpr pipeline::FrameRate kImageSequenceRate{10, 1};
 
 const char* extension_of(flow::FlowFormat format) {
   switch (format) {
-    case flow::FlowFormat::flo: return ".flo";
-    case flow::FlowFormat::kitti_png: return ".png";
-    case flow::FlowFormat::npy: return ".npy";
+    case flow::FlowFormat::flo:
+      return ".flo";
+    case flow::FlowFormat::kitti_png:
+      return ".png";
+    case flow::FlowFormat::npy:
+      return ".npy";
   }
   return ".flo";
 }
@@ -144,8 +147,8 @@ void Conversion::run(InputOutcome& outcome) {
     ++frames_read;
   }
   if (!from) {
-    throw InputError(kExitDataError, input_.label + ": has " + std::to_string(frames_read - 1) +
-                                         " frames; --frames " + settings_.frames->suffix() + " starts after its last");
+    throw InputError(kExitDataError, input_.label + ": has " + std::to_string(frames_read - 1) + " frames; --frames " +
+                                         settings_.frames->suffix() + " starts after its last");
   }
   progress_.set_total(total_pairs());  // a video's length is known once it plays
   while ((settings_.max_frames == 0 || frames_read < settings_.max_frames) && (!end || frames_read <= *end)) {
@@ -226,8 +229,7 @@ void Conversion::render(const flow::FlowField& field, const std::string& stem, b
     pipeline::FrameRate rate = frames_->frame_rate();
     if (input_.kind != InputKind::video && settings_.image_rate) rate = *settings_.image_rate;
     video_ = std::make_unique<pipeline::VideoEncoder>(dir_ / range_name("viz", ".mp4", settings_.frames), image.width,
-                                                      image.height,
-                                                      rate.known() ? rate : kImageSequenceRate);
+                                                      image.height, rate.known() ? rate : kImageSequenceRate);
   }
   video_->write(image);
 }

@@ -19,10 +19,10 @@
 
 #include "convert/input_error.hpp"
 #include "convert/inputs.hpp"
-#include "neuflow/pipeline/frame_rate.hpp"
 #include "convert/progress.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/model/flow_session.hpp"
+#include "neuflow/pipeline/frame_rate.hpp"
 
 namespace neuflow::cli {
 
@@ -41,9 +41,9 @@ struct ConvertSettings {
   std::filesystem::path output_dir;
   flow::FlowFormat format = flow::FlowFormat::flo;
   VizMode viz = VizMode::none;
-  double max_flow = 20;  // px at full saturation, fixed so colours mean the same in every frame
-  bool resume = false;   // keep flow files that exist and read back at the right size
-  std::int64_t max_frames = 0;  // 0: every frame; else only the first max_frames of each input
+  double max_flow = 20;              // px at full saturation, fixed so colours mean the same in every frame
+  bool resume = false;               // keep flow files that exist and read back at the right size
+  std::int64_t max_frames = 0;       // 0: every frame; else only the first max_frames of each input
   std::optional<FrameRange> frames;  // --frames A:B: one range of each input's pairs
   // The rate of viz.mp4 for images (a video keeps its own): unset, the rate the file names'
   // timestamps give, else 10 frames per second.
@@ -51,7 +51,7 @@ struct ConvertSettings {
 };
 
 struct InputOutcome {
-  std::filesystem::path output;  // the input's output folder
+  std::filesystem::path output;    // the input's output folder
   std::int64_t pairs_written = 0;  // flows computed and written
   std::int64_t pairs_skipped = 0;  // flows kept from an earlier run (--resume)
   double seconds = 0;

@@ -73,7 +73,8 @@ std::string Progress::status_text(bool with_bar) const {
   int bar = width_ - fixed - static_cast<int>(label.size());
   if (bar < 10) {
     const int keep = std::max(8, width_ - fixed - 10);
-    if (static_cast<int>(label.size()) > keep) label = "..." + label.substr(label.size() - static_cast<std::size_t>(keep - 3));
+    if (static_cast<int>(label.size()) > keep)
+      label = "..." + label.substr(label.size() - static_cast<std::size_t>(keep - 3));
     bar = std::max(10, width_ - fixed - static_cast<int>(label.size()));
   }
   const double fraction = std::clamp(static_cast<double>(done_) / static_cast<double>(*total_), 0.0, 1.0);

@@ -52,7 +52,8 @@ SetResult evaluate_set(const EvalSet& set, const FlowSource& source, const Evalu
   result.dataset = set.dataset;
   result.aggregation = set.aggregation;
   result.summary = overall.summary();
-  for (std::size_t s = 0; s < sequences.size(); ++s) result.sequences.push_back({sequence_names[s], sequences[s].summary()});
+  for (std::size_t s = 0; s < sequences.size(); ++s)
+    result.sequences.push_back({sequence_names[s], sequences[s].summary()});
   return result;
 }
 

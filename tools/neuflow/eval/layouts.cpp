@@ -65,7 +65,8 @@ fs::path find_base(const fs::path& root, const std::vector<std::string>& subdirs
   std::vector<fs::path> found;
   for (const auto& c : candidates) {
     std::error_code ec;
-    if (std::all_of(subdirs.begin(), subdirs.end(), [&](const std::string& s) { return fs::is_directory(c / s, ec); })) {
+    if (std::all_of(subdirs.begin(), subdirs.end(),
+                    [&](const std::string& s) { return fs::is_directory(c / s, ec); })) {
       found.push_back(c);
     }
   }
@@ -106,8 +107,8 @@ std::vector<EvalSet> sintel_sets(const fs::path& root, SintelPass which) {
       if (flows.empty()) continue;
       std::error_code ec;
       if (!fs::is_directory(image_dir, ec)) {
-        missing(image_dir.string() + ": no such folder (the " + pass + " images for " + (base / "flow" / scene).string() +
-                ")");
+        missing(image_dir.string() + ": no such folder (the " + pass + " images for " +
+                (base / "flow" / scene).string() + ")");
       }
       const auto images = list_names(image_dir, false, ".png");
       for (const auto& flo : flows) {
@@ -121,10 +122,12 @@ std::vector<EvalSet> sintel_sets(const fs::path& root, SintelPass which) {
         if (std::next(first) == images.end()) {
           missing(image_dir.string() + ": no frame after " + stem + ".png (the second image for " + gt.string() + ")");
         }
-        set.pairs.push_back({image_dir / *first, image_dir / *std::next(first), gt, scene, pass + "/" + scene + "/" + stem});
+        set.pairs.push_back(
+            {image_dir / *first, image_dir / *std::next(first), gt, scene, pass + "/" + scene + "/" + stem});
       }
     }
-    if (set.pairs.empty()) missing((base / "flow").string() + ": no <scene>/*.flo ground truth in the MPI-Sintel layout");
+    if (set.pairs.empty())
+      missing((base / "flow").string() + ": no <scene>/*.flo ground truth in the MPI-Sintel layout");
     sets.push_back(std::move(set));
   }
   return sets;
@@ -141,7 +144,8 @@ EvalSet kitti_set(const fs::path& root) {
   for (const auto& name : list_names(base / "flow_occ", false, "_10.png")) {
     const std::string id = name.substr(0, name.size() - 7);
     const fs::path gt = base / "flow_occ" / name;
-    Pair pair{base / "image_2" / (id + "_10.png"), base / "image_2" / (id + "_11.png"), gt, id, "image_2/" + id + "_10"};
+    Pair pair{base / "image_2" / (id + "_10.png"), base / "image_2" / (id + "_11.png"), gt, id,
+              "image_2/" + id + "_10"};
     require_file(pair.image0, gt);
     require_file(pair.image1, gt);
     set.pairs.push_back(std::move(pair));
@@ -155,7 +159,8 @@ EvalSet kitti_set(const fs::path& root) {
 std::optional<std::pair<std::string, std::string>> middlebury_frames(const std::string& flo) {
   if (flo.size() <= 8 || flo.compare(0, 4, "flow") != 0 || !ends_with(flo, ".flo")) return std::nullopt;
   const std::string digits = flo.substr(4, flo.size() - 8);
-  if (digits.size() > 6 || !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) {
+  if (digits.size() > 6 ||
+      !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); })) {
     return std::nullopt;
   }
   std::string next = std::to_string(std::stoi(digits) + 1);
@@ -260,10 +265,14 @@ std::optional<Dataset> parse_dataset(std::string_view name) {
 
 std::string_view to_string(Dataset dataset) {
   switch (dataset) {
-    case Dataset::sintel: return "sintel";
-    case Dataset::kitti: return "kitti";
-    case Dataset::middlebury: return "middlebury";
-    case Dataset::chairs: return "chairs";
+    case Dataset::sintel:
+      return "sintel";
+    case Dataset::kitti:
+      return "kitti";
+    case Dataset::middlebury:
+      return "middlebury";
+    case Dataset::chairs:
+      return "chairs";
   }
   return "unknown";
 }
@@ -273,10 +282,14 @@ std::vector<EvalSet> discover_sets(Dataset dataset, const fs::path& given_root, 
   fs::path root = fs::absolute(given_root).lexically_normal();
   if (!root.has_filename() && root.has_parent_path() && root != root.root_path()) root = root.parent_path();
   switch (dataset) {
-    case Dataset::sintel: return sintel_sets(root, options.sintel_pass);
-    case Dataset::kitti: return {kitti_set(root)};
-    case Dataset::middlebury: return {middlebury_set(root)};
-    case Dataset::chairs: return {chairs_set(root)};
+    case Dataset::sintel:
+      return sintel_sets(root, options.sintel_pass);
+    case Dataset::kitti:
+      return {kitti_set(root)};
+    case Dataset::middlebury:
+      return {middlebury_set(root)};
+    case Dataset::chairs:
+      return {chairs_set(root)};
   }
   return {};
 }

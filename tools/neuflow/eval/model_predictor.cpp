@@ -53,8 +53,8 @@ flow::FlowField ModelPredictor::predict(const cv::Mat& bgr0, const cv::Mat& bgr1
   try {
     return crop_flow(session_.compute(view(padded0), view(padded1)), padding);
   } catch (const std::invalid_argument& e) {
-    throw EvalError(EvalError::Kind::malformed_input, "cannot run the network on a " + size_text(bgr0) +
-                                                          " pair: " + e.what());
+    throw EvalError(EvalError::Kind::malformed_input,
+                    "cannot run the network on a " + size_text(bgr0) + " pair: " + e.what());
   }
 }
 

@@ -38,10 +38,9 @@ flow::FlowField crop_flow(const flow::FlowField& padded, const Padding& padding)
   const int width = padded.width - padding.left - padding.right;
   const int height = padded.height - padding.top - padding.bottom;
   if (width <= 0 || height <= 0 || std::min({padding.left, padding.right, padding.top, padding.bottom}) < 0) {
-    throw std::invalid_argument("crop_flow: a " + std::to_string(padded.width) + "x" +
-                                std::to_string(padded.height) + " field cannot lose padding left " +
-                                std::to_string(padding.left) + ", right " + std::to_string(padding.right) +
-                                ", top " + std::to_string(padding.top) + ", bottom " +
+    throw std::invalid_argument("crop_flow: a " + std::to_string(padded.width) + "x" + std::to_string(padded.height) +
+                                " field cannot lose padding left " + std::to_string(padding.left) + ", right " +
+                                std::to_string(padding.right) + ", top " + std::to_string(padding.top) + ", bottom " +
                                 std::to_string(padding.bottom));
   }
   flow::FlowField out(width, height);

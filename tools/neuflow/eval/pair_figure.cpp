@@ -14,7 +14,9 @@ namespace {
 constexpr int kGap = 4;
 constexpr std::uint8_t kGapGrey = 128;
 
-bool finite_pixel(const flow::FlowField& f, int x, int y) { return std::isfinite(f.u(x, y)) && std::isfinite(f.v(x, y)); }
+bool finite_pixel(const flow::FlowField& f, int x, int y) {
+  return std::isfinite(f.u(x, y)) && std::isfinite(f.v(x, y));
+}
 
 void paste(flow::RgbImage& canvas, const flow::RgbImage& panel, int left) {
   for (int y = 0; y < panel.height; ++y) {
@@ -52,11 +54,20 @@ std::string xml_text(const std::string& s) {
   std::string out;
   for (const char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -114,8 +125,8 @@ void write_epe_plot(const std::vector<SetResult>& results, const std::filesystem
   int y = kMargin;
   const double scale = largest > 0 ? (kWidth - kLabel - 80) / largest : 0;
   for (const auto& set : results) {
-    svg += "<text x=\"" + std::to_string(kMargin) + "\" y=\"" + std::to_string(y + 18) +
-           "\" font-weight=\"bold\">" + xml_text(set.name) + ": EPE " + number(set.summary.epe) + " px</text>\n";
+    svg += "<text x=\"" + std::to_string(kMargin) + "\" y=\"" + std::to_string(y + 18) + "\" font-weight=\"bold\">" +
+           xml_text(set.name) + ": EPE " + number(set.summary.epe) + " px</text>\n";
     y += kTitle;
     for (const auto& seq : set.sequences) {
       const double epe = seq.summary.epe;

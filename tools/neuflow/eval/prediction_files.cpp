@@ -17,7 +17,8 @@ std::filesystem::path find_prediction(const std::filesystem::path& dir, const Pa
     if (std::filesystem::is_regular_file(candidate, ec)) return candidate;
   }
   throw EvalError(EvalError::Kind::missing_input, stem.string() + ".{flo,png,npy}: no prediction for " +
-                                                      pair.image0.string() + " (expected DIR/<first image's path "
+                                                      pair.image0.string() +
+                                                      " (expected DIR/<first image's path "
                                                       "in the dataset, without extension> + .flo, .png or .npy)");
 }
 

@@ -30,8 +30,8 @@ std::string pad_right(const std::string& s, std::size_t width) {
 }
 
 std::string table_row(const std::string& name, std::size_t name_width, const Summary& s, bool with_fl) {
-  std::string row = pad_right(name, name_width) + pad_left(std::to_string(s.pairs), 7) +
-                    pad_left(cell(s.epe, false), 10);
+  std::string row =
+      pad_right(name, name_width) + pad_left(std::to_string(s.pairs), 7) + pad_left(cell(s.epe, false), 10);
   if (with_fl) row += pad_left(cell(s.fl_all, true), 9);
   for (double rate : {s.within_1px, s.within_3px, s.within_5px}) row += pad_left(cell(rate, true), 9);
   return row + "\n";
@@ -49,11 +49,21 @@ std::string json_string(const std::string& s) {
   std::string out = "\"";
   for (const char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
@@ -77,7 +87,8 @@ std::string json_summary_fields(const Summary& s) {
 }  // namespace
 
 std::string format_table(const std::vector<SetResult>& results, bool per_sequence) {
-  const bool with_fl = std::any_of(results.begin(), results.end(), [](const SetResult& r) { return r.dataset == Dataset::kitti; });
+  const bool with_fl =
+      std::any_of(results.begin(), results.end(), [](const SetResult& r) { return r.dataset == Dataset::kitti; });
   std::size_t name_width = 4;
   for (const auto& r : results) {
     name_width = std::max(name_width, r.name.size());
@@ -105,16 +116,17 @@ std::string format_json(const RunDescription& run, const std::vector<SetResult>&
     out += ", \"source\": \"predictions\", \"predictions\": " + json_string(run.predictions.string());
   } else {
     out += ", \"source\": \"model\", \"model\": " + json_string(run.model.string()) +
-           ", \"iters_s16\": " + std::to_string(run.iterations.s16) + ", \"iters_s8\": " +
-           std::to_string(run.iterations.s8) + ", \"channel_order\": \"" + std::string(model::channel_order_name(run.network_order)) + "\"";
+           ", \"iters_s16\": " + std::to_string(run.iterations.s16) +
+           ", \"iters_s8\": " + std::to_string(run.iterations.s8) + ", \"channel_order\": \"" +
+           std::string(model::channel_order_name(run.network_order)) + "\"";
   }
   out += ", \"max_pairs\": " + (run.max_pairs == 0 ? std::string("null") : std::to_string(run.max_pairs));
   out += ",\n \"results\": [";
   for (std::size_t i = 0; i < results.size(); ++i) {
     const SetResult& r = results[i];
     out += std::string(i ? ",\n  " : "\n  ") + "{\"set\": " + json_string(r.name) + ", " +
-           json_summary_fields(r.summary) + ", \"epe_aggregation\": " +
-           (r.aggregation == Aggregation::mean_of_images ? "\"images\"" : "\"pixels\"");
+           json_summary_fields(r.summary) +
+           ", \"epe_aggregation\": " + (r.aggregation == Aggregation::mean_of_images ? "\"images\"" : "\"pixels\"");
     if (per_sequence) {
       out += ", \"sequences\": [";
       for (std::size_t s = 0; s < r.sequences.size(); ++s) {

@@ -87,8 +87,8 @@ class TempFile {
     fd_ = -1;
     if (::close(fd) != 0) fail("closing");
     if (::rename(path_.c_str(), destination.c_str()) != 0) {
-      throw FetchError(Kind::kLocalIo, "cannot rename " + path_.string() + " to " + destination.string() + ": " +
-                                           std::strerror(errno));
+      throw FetchError(Kind::kLocalIo,
+                       "cannot rename " + path_.string() + " to " + destination.string() + ": " + std::strerror(errno));
     }
     committed_ = true;
     const fs::path dir = destination.has_parent_path() ? destination.parent_path() : fs::path(".");
@@ -180,8 +180,9 @@ class VerifyingSink : public HttpBodySink {
  private:
   [[noreturn]] void too_large(std::int64_t announced) const {
     const std::string size = announced >= 0 ? std::to_string(announced) + " bytes" : "more than that";
-    throw FetchError(Kind::kIntegrity, url_ + ": the server sends " + size + ", but a checkpoint is far smaller (limit " +
-                                           std::to_string(kMaxBytes) + " bytes); is the URL right?");
+    throw FetchError(Kind::kIntegrity, url_ + ": the server sends " + size +
+                                           ", but a checkpoint is far smaller (limit " + std::to_string(kMaxBytes) +
+                                           " bytes); is the URL right?");
   }
 
   TempFile& file_;
@@ -202,8 +203,9 @@ bool already_present(const FetchRequest& request, const std::string& expected) {
   if (request.force) return false;
   const std::string actual = git_blob_sha1_of_file(request.destination);
   if (actual == expected) return true;
-  throw FetchError(Kind::kLocalIo, request.destination.string() + " already exists but is not the expected file (git blob SHA-1 " +
-                                       actual + ", expected " + expected + "); pass --force to replace it");
+  throw FetchError(Kind::kLocalIo, request.destination.string() +
+                                       " already exists but is not the expected file (git blob SHA-1 " + actual +
+                                       ", expected " + expected + "); pass --force to replace it");
 }
 
 }  // namespace

@@ -44,7 +44,7 @@ struct FetchRequest {
 struct FetchResult {
   bool downloaded = false;  // false: the destination was already there and verified
   std::uintmax_t bytes = 0;
-  std::string sha1;         // the verified git blob SHA-1, lowercase
+  std::string sha1;  // the verified git blob SHA-1, lowercase
 };
 
 // Throws FetchError. On any failure the destination is as it was and no temporary file

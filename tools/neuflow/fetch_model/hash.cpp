@@ -62,7 +62,8 @@ std::string git_blob_sha1_of_file(const std::filesystem::path& path) {
     hasher.update(std::as_bytes(std::span(buffer.data(), got)));
   }
   if (in.bad() || hasher.fed() != size) {
-    throw FetchError(FetchError::Kind::kLocalIo, path.string() + ": read error (or the file changed while it was hashed)");
+    throw FetchError(FetchError::Kind::kLocalIo,
+                     path.string() + ": read error (or the file changed while it was hashed)");
   }
   return hasher.hex_digest();
 }

@@ -164,9 +164,9 @@ extern "C" int on_progress(void* user, curl_off_t dltotal, curl_off_t dlnow, cur
       throw FetchError(Kind::kUnavailable,
                        "offline? could not connect to " + host_of(url) + " (fetching " + url + "): " + detail);
     case CURLE_OPERATION_TIMEDOUT:
-      throw FetchError(Kind::kUnavailable,
-                       url + ": timed out (" + detail + "); connect timeout " + std::to_string(options.connect_timeout_s) +
-                           " s, stall timeout " + std::to_string(options.stall_timeout_s) + " s");
+      throw FetchError(Kind::kUnavailable, url + ": timed out (" + detail + "); connect timeout " +
+                                               std::to_string(options.connect_timeout_s) + " s, stall timeout " +
+                                               std::to_string(options.stall_timeout_s) + " s");
     case CURLE_HTTP_RETURNED_ERROR: {
       long status = 0;
       curl_easy_getinfo(curl, CURLINFO_RESPONSE_CODE, &status);

@@ -11,8 +11,7 @@ using Rgb8 = std::array<std::uint8_t, 3>;
 
 // Segment lengths of the wheel: red→yellow, yellow→green, green→cyan, cyan→blue,
 // blue→magenta, magenta→red.
-inline constexpr int kWheelRY = 15, kWheelYG = 6, kWheelGC = 4, kWheelCB = 11, kWheelBM = 13,
-                     kWheelMR = 6;
+inline constexpr int kWheelRY = 15, kWheelYG = 6, kWheelGC = 4, kWheelCB = 11, kWheelBM = 13, kWheelMR = 6;
 inline constexpr int kWheelSize = kWheelRY + kWheelYG + kWheelGC + kWheelCB + kWheelBM + kWheelMR;
 
 // The 55 wheel colours, RGB, index 0 = pure red.

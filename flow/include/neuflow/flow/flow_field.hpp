@@ -10,8 +10,8 @@ namespace neuflow::flow {
 struct FlowField {
   int width = 0;
   int height = 0;
-  std::vector<float> uv;        // interleaved u,v; row-major; size 2 * width * height
-  std::vector<uint8_t> valid;   // empty: every pixel valid; else width * height, 0 = invalid
+  std::vector<float> uv;       // interleaved u,v; row-major; size 2 * width * height
+  std::vector<uint8_t> valid;  // empty: every pixel valid; else width * height, 0 = invalid
 
   FlowField() = default;
   FlowField(int w, int h) : width(w), height(h), uv(2 * static_cast<std::size_t>(w) * h, 0.f) {}

@@ -19,12 +19,12 @@ inline constexpr std::size_t kFlowIndexFileColumn = 5;
 
 // One row.
 struct FlowIndexRow {
-  std::int64_t index = 0;  // the flow file's index
+  std::int64_t index = 0;       // the flow file's index
   std::int64_t from_frame = 0;  // the frames the flow goes from and to
   std::int64_t to_frame = 0;
   std::optional<std::int64_t> from_pts_ns, to_pts_ns;  // their timestamps: empty fields when unknown
-  std::string file;  // the flow file, as the index names it
-  std::string from_source, to_source;  // the frames' image files: empty when there are none
+  std::string file;                                    // the flow file, as the index names it
+  std::string from_source, to_source;                  // the frames' image files: empty when there are none
 };
 
 // The header line, line break included.

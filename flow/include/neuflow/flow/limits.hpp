@@ -11,8 +11,7 @@ inline constexpr std::int64_t kMaxFlowPixels = std::int64_t{1} << 28;
 
 // True when width × height is a field size the readers and writers accept.
 constexpr bool flow_size_acceptable(std::int64_t width, std::int64_t height) {
-  return width > 0 && height > 0 && width <= kMaxFlowSide && height <= kMaxFlowSide &&
-         width * height <= kMaxFlowPixels;
+  return width > 0 && height > 0 && width <= kMaxFlowSide && height <= kMaxFlowSide && width * height <= kMaxFlowPixels;
 }
 
 }  // namespace neuflow::flow

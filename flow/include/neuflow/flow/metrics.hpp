@@ -20,8 +20,8 @@ struct MetricCounts {
 };
 
 struct FlowMetrics {
-  double epe = 0;     // mean end-point error |pred − gt| in px
-  double fl_all = 0;  // KITTI Fl-all: share with error > 3 px and > 5% of |gt|, in [0, 1]
+  double epe = 0;         // mean end-point error |pred − gt| in px
+  double fl_all = 0;      // KITTI Fl-all: share with error > 3 px and > 5% of |gt|, in [0, 1]
   double within_1px = 0;  // share of pixels with error < 1 px, in [0, 1]
   double within_3px = 0;
   double within_5px = 0;

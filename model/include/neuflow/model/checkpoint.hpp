@@ -32,8 +32,7 @@ class CheckpointError : public std::runtime_error {
     kUnsupported,  // well-formed but not supported (legacy format, dtype, object type)
     kUnsafe,       // the pickle references a global outside the allow-list
   };
-  CheckpointError(Kind kind, const std::string& message)
-      : std::runtime_error(message), kind_(kind) {}
+  CheckpointError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const noexcept { return kind_; }
 
  private:
@@ -56,11 +55,11 @@ struct CheckpointTensor {
 };
 
 struct Checkpoint {
-  std::string path;       // as given to load_checkpoint
-  std::string container;  // e.g. "PyTorch zip (folder 'archive/'), pickle protocol 2"
-  std::string wrapper;    // where the state dict was: "model", "state_dict" or "bare"
-  bool stripped_module_prefix = false;      // every key had "module." and it was removed
-  std::vector<std::string> keys;            // state-dict keys in file order (prefix stripped)
+  std::string path;                                 // as given to load_checkpoint
+  std::string container;                            // e.g. "PyTorch zip (folder 'archive/'), pickle protocol 2"
+  std::string wrapper;                              // where the state dict was: "model", "state_dict" or "bare"
+  bool stripped_module_prefix = false;              // every key had "module." and it was removed
+  std::vector<std::string> keys;                    // state-dict keys in file order (prefix stripped)
   std::map<std::string, CheckpointTensor> tensors;  // by key
 
   // The tensor named `key`, or nullptr.

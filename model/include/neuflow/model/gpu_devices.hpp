@@ -12,10 +12,10 @@ namespace neuflow::model {
 class BackendError : public std::runtime_error {
  public:
   enum class Kind {
-    unavailable,     // no Vulkan loader, no driver, or no such device
-    out_of_memory,   // device (or host) memory exhausted, or the configured budget
-    device_lost,     // the device was lost; a new session opens it again
-    driver,          // the driver refused something else (e.g. a pipeline)
+    unavailable,    // no Vulkan loader, no driver, or no such device
+    out_of_memory,  // device (or host) memory exhausted, or the configured budget
+    device_lost,    // the device was lost; a new session opens it again
+    driver,         // the driver refused something else (e.g. a pipeline)
   };
   BackendError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const { return kind_; }
@@ -25,15 +25,15 @@ class BackendError : public std::runtime_error {
 };
 
 struct GpuDevice {
-  int index = 0;             // what SessionOptions::device, --device and `device =` take
-  std::string name;          // e.g. "NVIDIA H200", "llvmpipe (LLVM 15.0.6, 256 bits)"
-  std::string type;          // discrete, integrated, virtual, cpu, other
-  std::string api_version;   // e.g. "1.3.230"
-  std::string driver;        // driver name and version text
-  std::uint64_t memory_bytes = 0;  // device-local heaps
+  int index = 0;                       // what SessionOptions::device, --device and `device =` take
+  std::string name;                    // e.g. "NVIDIA H200", "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string type;                    // discrete, integrated, virtual, cpu, other
+  std::string api_version;             // e.g. "1.3.230"
+  std::string driver;                  // driver name and version text
+  std::uint64_t memory_bytes = 0;      // device-local heaps
   std::uint64_t max_buffer_bytes = 0;  // maxStorageBufferRange
-  bool fp16 = false;         // shaderFloat16 and 16-bit storage
-  bool timestamps = false;   // its compute queue has timestamps: FlowSession::device_stage_times()
+  bool fp16 = false;                   // shaderFloat16 and 16-bit storage
+  bool timestamps = false;             // its compute queue has timestamps: FlowSession::device_stage_times()
   bool is_gpu() const { return type == "discrete" || type == "integrated"; }
 };
 

@@ -8,7 +8,7 @@
 namespace neuflow::model {
 
 struct NetworkCost {
-  double backbone = 0;         // one frame
+  double backbone = 0;           // one frame
   double upsample_features = 0;  // conv_s8, one frame
   double cross_attention = 0;
   double global_matching = 0;
@@ -23,9 +23,7 @@ struct NetworkCost {
   double stream_frame() const { return backbone + upsample_features + per_pair(); }
 
  private:
-  double per_pair() const {
-    return cross_attention + global_matching + refine_s16 + merge_s8 + refine_s8 + upsampler;
-  }
+  double per_pair() const { return cross_attention + global_matching + refine_s16 + merge_s8 + refine_s8 + upsampler; }
 };
 
 // height, width: the model resolution (multiples of 16).

@@ -74,7 +74,7 @@ struct SessionOptions {
 // or nothing when the value is usable.
 std::optional<std::string> check_iterations_s16(int value);
 std::optional<std::string> check_iterations_s8(int value);
-std::optional<std::string> check_model_side(int value);   // one of model width/height; 0 allowed
+std::optional<std::string> check_model_side(int value);  // one of model width/height; 0 allowed
 std::optional<std::string> check_threads(int value);
 std::optional<std::string> check_device(int value);
 // Both sides: each usable, and both 0 or both set.
@@ -100,16 +100,23 @@ constexpr std::string_view backend_name(Backend backend) {
 }
 std::optional<Backend> parse_backend(std::string_view name);  // "auto", "cpu", "vulkan"
 
-constexpr std::string_view precision_name(Precision precision) { return precision == Precision::fp16 ? "fp16" : "fp32"; }
+constexpr std::string_view precision_name(Precision precision) {
+  return precision == Precision::fp16 ? "fp16" : "fp32";
+}
 std::optional<Precision> parse_precision(std::string_view name);  // "fp32", "fp16"
 
 constexpr std::string_view cpu_convolution_name(CpuConvolution c) {
   switch (c) {
-    case CpuConvolution::direct: return "direct";
-    case CpuConvolution::winograd: return "winograd";
-    case CpuConvolution::winograd4: return "winograd4";
-    case CpuConvolution::winograd6: return "winograd6";
-    case CpuConvolution::automatic: break;
+    case CpuConvolution::direct:
+      return "direct";
+    case CpuConvolution::winograd:
+      return "winograd";
+    case CpuConvolution::winograd4:
+      return "winograd4";
+    case CpuConvolution::winograd6:
+      return "winograd6";
+    case CpuConvolution::automatic:
+      break;
   }
   return "auto";
 }

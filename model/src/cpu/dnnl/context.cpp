@@ -11,8 +11,6 @@ dnnl::memory::desc nhwc_desc(int h, int w, int c) {
   return dnnl::memory::desc({1, c, h, w}, dnnl::memory::data_type::f32, dnnl::memory::format_tag::nhwc);
 }
 
-dnnl::memory wrap_nhwc(Tensor& t) {
-  return dnnl::memory(nhwc_desc(t.h, t.w, t.c), cpu_engine(), t.data.data());
-}
+dnnl::memory wrap_nhwc(Tensor& t) { return dnnl::memory(nhwc_desc(t.h, t.w, t.c), cpu_engine(), t.data.data()); }
 
 }  // namespace neuflow::model

@@ -1,8 +1,8 @@
 #include "dnnl/conv_op.hpp"
 
 #include <cstring>
-#include <utility>
 #include <stdexcept>
+#include <utility>
 
 #include "dnnl/context.hpp"
 
@@ -18,10 +18,17 @@ dnnl::primitive_attr make_attr(const ConvParams& p) {
   dnnl::post_ops ops;
   if (p.accumulate) ops.append_sum(1.f);
   switch (p.activation) {
-    case Activation::none: break;
-    case Activation::leaky_relu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.1f, 0.f); break;
-    case Activation::relu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.f, 0.f); break;
-    case Activation::gelu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_gelu_erf, 0.f, 0.f); break;
+    case Activation::none:
+      break;
+    case Activation::leaky_relu:
+      ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.1f, 0.f);
+      break;
+    case Activation::relu:
+      ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.f, 0.f);
+      break;
+    case Activation::gelu:
+      ops.append_eltwise(1.f, dnnl::algorithm::eltwise_gelu_erf, 0.f, 0.f);
+      break;
   }
   dnnl::primitive_attr attr;
   attr.set_post_ops(ops);
@@ -37,8 +44,9 @@ constexpr int kWinogradMinInputChannels = 32;
 std::optional<ChannelLayout> winograd_layout(const memory::desc& d) {
   const auto dims = d.dims();
   if (dims.size() != 4) return std::nullopt;
-  for (const auto& [t, layout] : {std::pair{tag::nhwc, ChannelLayout::nhwc}, std::pair{tag::nChw8c, ChannelLayout::blocked8},
-                                 std::pair{tag::nChw16c, ChannelLayout::blocked16}}) {
+  for (const auto& [t, layout] :
+       {std::pair{tag::nhwc, ChannelLayout::nhwc}, std::pair{tag::nChw8c, ChannelLayout::blocked8},
+        std::pair{tag::nChw16c, ChannelLayout::blocked16}}) {
     if (d == memory::desc(dims, dt::f32, t)) return layout;
   }
   return std::nullopt;
@@ -91,7 +99,8 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
   out_w_ = (in_w + 2 * p.pad - w.kernel_w) / p.stride + 1;
 
   if (use_winograd(w, p, in_h, in_w, context.convolution, output)) {
-    const memory::desc out_desc = output ? *output : memory::desc({1, out_c_, out_h_, out_w_}, dt::f32, preferred_blocking());
+    const memory::desc out_desc =
+        output ? *output : memory::desc({1, out_c_, out_h_, out_w_}, dt::f32, preferred_blocking());
     memory::desc in_desc = input;
     if (!winograd_layout(input)) {  // not one it reads in place
       in_desc = memory::desc({1, w.in_channels, in_h, in_w}, dt::f32, preferred_blocking());
@@ -121,9 +130,9 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
   const memory::desc dst_md = output ? *output : memory::desc(dst_dims, dt::f32, tag::any);
   const memory::desc bias_md = w.bias.empty() ? memory::desc() : memory::desc({out_c_}, dt::f32, tag::x);
 
-  const auto desc = dnnl::convolution_forward::desc(
-      dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, src_any, wei_any, bias_md,
-      dst_md, {p.stride, p.stride}, {p.pad, p.pad}, {p.pad, p.pad});
+  const auto desc =
+      dnnl::convolution_forward::desc(dnnl::prop_kind::forward_inference, dnnl::algorithm::convolution_direct, src_any,
+                                      wei_any, bias_md, dst_md, {p.stride, p.stride}, {p.pad, p.pad}, {p.pad, p.pad});
   const dnnl::convolution_forward::primitive_desc pd(desc, make_attr(p), eng);
   conv_ = dnnl::convolution_forward(pd);
 

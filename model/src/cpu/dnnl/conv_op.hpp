@@ -19,16 +19,14 @@ class ConvOp {
   // `input` describes the memory run() will receive: NHWC from a stage, or a previous
   // ConvOp's output(). The output and any reordered input live in the context's arena
   // (current region). `output` forces the output layout (default: the primitive's choice).
-  ConvOp(const ConvWeights& weights, const ConvParams& params, const dnnl::memory::desc& input,
-         PlanContext& context, std::optional<dnnl::memory::desc> output = std::nullopt);
+  ConvOp(const ConvWeights& weights, const ConvParams& params, const dnnl::memory::desc& input, PlanContext& context,
+         std::optional<dnnl::memory::desc> output = std::nullopt);
 
   // Runs the convolution; `addend` (required iff params.accumulate) must have output_desc().
-  const dnnl::memory& run(dnnl::stream& stream, const dnnl::memory& input,
-                          const dnnl::memory* addend = nullptr);
+  const dnnl::memory& run(dnnl::stream& stream, const dnnl::memory& input, const dnnl::memory* addend = nullptr);
 
   // Runs and converts the output to NHWC into `out` (resized as needed).
-  void run_to_nhwc(dnnl::stream& stream, const dnnl::memory& input, Tensor& out,
-                   const dnnl::memory* addend = nullptr);
+  void run_to_nhwc(dnnl::stream& stream, const dnnl::memory& input, Tensor& out, const dnnl::memory* addend = nullptr);
 
   const dnnl::memory& output() const { return dst_; }
   dnnl::memory::desc output_desc() const { return dst_.get_desc(); }

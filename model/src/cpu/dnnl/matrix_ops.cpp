@@ -30,10 +30,9 @@ void matmul(dnnl::stream& stream, MatrixView a, MatrixView b, float* c, int ldc,
     attr.set_post_ops(ops);
   }
   const dnnl::matmul::primitive_desc pd(dnnl::matmul::desc(a_md, b_md, bias_md, c_md), attr, eng);
-  std::unordered_map<int, memory> args{
-      {DNNL_ARG_SRC, memory(a_md, eng, const_cast<float*>(a.data))},
-      {DNNL_ARG_WEIGHTS, memory(b_md, eng, const_cast<float*>(b.data))},
-      {DNNL_ARG_DST, memory(c_md, eng, c)}};
+  std::unordered_map<int, memory> args{{DNNL_ARG_SRC, memory(a_md, eng, const_cast<float*>(a.data))},
+                                       {DNNL_ARG_WEIGHTS, memory(b_md, eng, const_cast<float*>(b.data))},
+                                       {DNNL_ARG_DST, memory(c_md, eng, c)}};
   if (bias) args.emplace(DNNL_ARG_BIAS, memory(bias_md, eng, const_cast<float*>(bias)));
   dnnl::matmul(pd).execute(stream, args);
 }

@@ -30,7 +30,8 @@ void ScratchArena::make_tensor(Tensor& tensor, int h, int w, int c) {
 }
 
 void ScratchArena::release(const Tensor& tensor) {
-  const auto b = std::find_if(bindings_.begin(), bindings_.end(), [&](const Binding& x) { return x.tensor == &tensor; });
+  const auto b =
+      std::find_if(bindings_.begin(), bindings_.end(), [&](const Binding& x) { return x.tensor == &tensor; });
   if (b == bindings_.end()) throw std::logic_error("ScratchArena: release() of a tensor it did not make");
   release(b->memory);
 }
@@ -83,7 +84,8 @@ void ScratchArena::finalize() {
   auto* base = reinterpret_cast<std::byte*>(align_up(reinterpret_cast<std::size_t>(storage_.get())));
   for (auto& b : bindings_) {
     b.memory.set_data_handle(base + b.offset);
-    if (b.tensor) b.tensor->data.view(static_cast<float*>(static_cast<void*>(base + b.offset)), b.tensor->pixels() * b.tensor->c);
+    if (b.tensor)
+      b.tensor->data.view(static_cast<float*>(static_cast<void*>(base + b.offset)), b.tensor->pixels() * b.tensor->c);
   }
 }
 

@@ -55,10 +55,10 @@ class ScratchArena {
     dnnl::memory memory;
     std::size_t size;
     std::size_t region;
-    std::size_t made;                  // lifetime [made, released) in make/release events
+    std::size_t made;  // lifetime [made, released) in make/release events
     std::size_t released = kForever;
-    std::size_t offset = 0;            // chosen by finalize()
-    Tensor* tensor = nullptr;          // bound to the memory by finalize()
+    std::size_t offset = 0;    // chosen by finalize()
+    Tensor* tensor = nullptr;  // bound to the memory by finalize()
   };
   static constexpr std::size_t kForever = static_cast<std::size_t>(-1);
   void place_region(std::size_t region);

@@ -26,8 +26,7 @@ void copy_channels(const ChannelSlice& src, Tensor& dst, int dst_offset, bool re
 
 // Nearest-neighbour 2× upsampling of `src` into channels starting at dst_offset of `dst`
 // (dst is 2h × 2w), each value multiplied by `scale`; relu first if asked.
-void upsample_nearest_2x(const ChannelSlice& src, Tensor& dst, int dst_offset, float scale = 1.f,
-                         bool relu = false);
+void upsample_nearest_2x(const ChannelSlice& src, Tensor& dst, int dst_offset, float scale = 1.f, bool relu = false);
 
 // A fresh tensor holding a copy of a channel range (for observers and tests).
 Tensor extract_channels(const ChannelSlice& src);

@@ -4,8 +4,7 @@
 
 namespace neuflow::model {
 
-void layer_norm_rows(float* data, int rows, int dim, const std::vector<float>& gamma,
-                     const std::vector<float>& beta) {
+void layer_norm_rows(float* data, int rows, int dim, const std::vector<float>& gamma, const std::vector<float>& beta) {
   constexpr double kEps = 1e-5;
 #pragma omp parallel for
   for (int r = 0; r < rows; ++r) {

@@ -106,8 +106,7 @@ void local_correlation(const ChannelSlice& f0, const ChannelSlice& f1, const Ten
       const float w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay, w11 = ax * ay;
       for (int i = 0; i < kCorrWindow; ++i) {
         for (int j = 0; j < kCorrWindow; ++j) {
-          o[i * kCorrWindow + j] =
-              w00 * d[i][j] + w10 * d[i + 1][j] + w01 * d[i][j + 1] + w11 * d[i + 1][j + 1];
+          o[i * kCorrWindow + j] = w00 * d[i][j] + w10 * d[i + 1][j] + w01 * d[i][j + 1] + w11 * d[i + 1][j + 1];
         }
       }
     }

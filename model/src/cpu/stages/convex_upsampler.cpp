@@ -42,8 +42,8 @@ const Tensor& ConvexUpsampler::run(dnnl::stream& stream, const Tensor& flow8, co
   const auto* features = static_cast<const float*>(features_memory.get_data_handle());
   const int h8 = flow8.h, w8 = flow8.w;
   const int depth = mask_head_->in_channels;
-  constexpr int kWeights = kFactor * kFactor;           // output pixels per coarse pixel
-  constexpr int kLogits = kNeighbours * kWeights;       // channel k · 64 + a · 8 + b
+  constexpr int kWeights = kFactor * kFactor;      // output pixels per coarse pixel
+  constexpr int kLogits = kNeighbours * kWeights;  // channel k · 64 + a · 8 + b
   for (int y0 = 0; y0 < h8; y0 += band_rows_) {
     const int rows = std::min(band_rows_, h8 - y0);
     const int pixels = rows * w8;

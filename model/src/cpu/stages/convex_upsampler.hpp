@@ -26,9 +26,9 @@ class ConvexUpsampler {
  private:
   Tensor input_, flow_;
   std::optional<ConvOp> conv1_, conv2_;  // conv2 writes NHWC: rows of 512 features per pixel
-  const ConvWeights* mask_head_;          // the 1×1 512 → 576 layer, [576][512] row-major
+  const ConvWeights* mask_head_;         // the 1×1 512 → 576 layer, [576][512] row-major
   int band_rows_;
-  std::vector<float> band_;               // one band's logits: [pixels][9 · 64]
+  std::vector<float> band_;  // one band's logits: [pixels][9 · 64]
 };
 
 }  // namespace neuflow::model

@@ -25,12 +25,13 @@ CrossAttention::CrossAttention(const NetworkWeights& weights, int h16, int w16, 
   arena.make_tensor(mlp_hidden_, 1, l, 2 * kFeatureChannels);
 }
 
-void CrossAttention::layer(dnnl::stream& stream, const AttentionLayerWeights& w, const float* src,
-                           const float* tgt, float* out) {
+void CrossAttention::layer(dnnl::stream& stream, const AttentionLayerWeights& w, const float* src, const float* tgt,
+                           float* out) {
   const int l = tokens_;
   const auto linear = [&](const float* in, int in_dim, const LinearWeights& lw, float* dst, bool gelu) {
     matmul(stream, rows(in, l, in_dim, in_dim), rows(lw.weight.data(), lw.out_features, lw.in_features, lw.in_features),
-           dst, lw.out_features, {.transpose_b = true, .bias = lw.bias.empty() ? nullptr : lw.bias.data(), .gelu = gelu});
+           dst, lw.out_features,
+           {.transpose_b = true, .bias = lw.bias.empty() ? nullptr : lw.bias.data(), .gelu = gelu});
   };
   linear(src, kFeatureChannels, w.q_proj, q_.data.data(), false);  // already scaled by 1/sqrt(192)
   linear(tgt, kFeatureChannels, w.k_proj, k_.data.data(), false);
@@ -38,8 +39,10 @@ void CrossAttention::layer(dnnl::stream& stream, const AttentionLayerWeights& w,
 
   for (int r0 = 0; r0 < l; r0 += block_rows_) {
     const int n = std::min(block_rows_, l - r0);
-    matmul(stream, rows(q_.data.data() + static_cast<std::size_t>(r0) * kFeatureChannels, n, kFeatureChannels, kFeatureChannels), rows(k_.data.data(), l, kFeatureChannels, kFeatureChannels),
-           scores_.data.data(), l, {.transpose_b = true});
+    matmul(
+        stream,
+        rows(q_.data.data() + static_cast<std::size_t>(r0) * kFeatureChannels, n, kFeatureChannels, kFeatureChannels),
+        rows(k_.data.data(), l, kFeatureChannels, kFeatureChannels), scores_.data.data(), l, {.transpose_b = true});
     softmax_rows(stream, scores_.data.data(), n, l);
     matmul(stream, rows(scores_.data.data(), n, l, l), rows(v_.data.data(), l, kFeatureChannels, kFeatureChannels),
            message_.data.data() + static_cast<std::size_t>(r0) * kFeatureChannels, kFeatureChannels);
@@ -53,7 +56,8 @@ void CrossAttention::layer(dnnl::stream& stream, const AttentionLayerWeights& w,
   for (int t = 0; t < l; ++t) {
     float* row = mlp_in_.data.data() + static_cast<std::size_t>(t) * 2 * kFeatureChannels;
     std::copy_n(src + static_cast<std::size_t>(t) * kFeatureChannels, kFeatureChannels, row);
-    std::copy_n(q_.data.data() + static_cast<std::size_t>(t) * kFeatureChannels, kFeatureChannels, row + kFeatureChannels);
+    std::copy_n(q_.data.data() + static_cast<std::size_t>(t) * kFeatureChannels, kFeatureChannels,
+                row + kFeatureChannels);
   }
 
   linear(mlp_in_.data.data(), 2 * kFeatureChannels, w.mlp0, mlp_hidden_.data.data(), true);
@@ -65,8 +69,7 @@ void CrossAttention::layer(dnnl::stream& stream, const AttentionLayerWeights& w,
   for (std::size_t i = 0; i < total; ++i) out[i] = src[i] + message_.data[i];
 }
 
-void CrossAttention::run(dnnl::stream& stream, const Tensor& f16_0, const Tensor& f16_1, Tensor& out0,
-                         Tensor& out1) {
+void CrossAttention::run(dnnl::stream& stream, const Tensor& f16_0, const Tensor& f16_1, Tensor& out0, Tensor& out1) {
   out0.resize(f16_0.h, f16_0.w, kFeatureChannels);
   out1.resize(f16_1.h, f16_1.w, kFeatureChannels);
   // Layer 0 reads the backbone features, layer 1 reads layer 0's outputs of both frames.

@@ -74,8 +74,8 @@ FrameEncoder::FrameEncoder(const NetworkWeights& w, int height, int width, PlanC
   block_cat_16_ = make_block(w.block_cat_16, 1, 1, cat16_.get_desc(), context);
   arena.release(cat16_);
   arena.make_tensor(g_, height / 16, width / 16, block_cat_16_.conv2->out_channels());  // NHWC copy of the output
-  arena.release(block_cat_16_.conv2->output());  // read by to_nhwc only
-  arena.release(g_);                             // read into f16, the last step
+  arena.release(block_cat_16_.conv2->output());                                         // read by to_nhwc only
+  arena.release(g_);                                                                    // read into f16, the last step
 }
 
 void FrameEncoder::run(dnnl::stream& stream, const Tensor& image, FrameFeatures& out) {
@@ -109,7 +109,6 @@ void FrameEncoder::run(dnnl::stream& stream, const Tensor& image, FrameFeatures&
       dst[g_.c + 1] = static_cast<float>(x) - static_cast<float>(w16) / 2.f;
     }
   }
-
 }
 
 }  // namespace neuflow::model

@@ -21,11 +21,12 @@ Refinement::Refinement(const RefineWeights& w, int h, int width, int iterations,
   // flow go through input_), so each convolution's output is released once the next one is
   // built; conv1_constant's stays for the pair, and conv1 writes its sum in that layout.
   ScratchArena& arena = context.arena;
-  conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c), context);
+  conv1_constant_.emplace(w.conv1_constant, ConvParams{1, 1, Activation::none}, nhwc_desc(h, width, constant_.c),
+                          context);
   conv1_constant_->release_scratch(arena);
   arena.release(constant_);  // read in begin() only
-  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true, repeated}, nhwc_desc(h, width, input_.c), context,
-                 conv1_constant_->output_desc());
+  conv1_.emplace(w.conv1_dynamic, ConvParams{1, 1, Activation::leaky_relu, true, repeated},
+                 nhwc_desc(h, width, input_.c), context, conv1_constant_->output_desc());
   conv1_->release_scratch(arena);
   conv2_.emplace(w.conv2, ConvParams{1, 1, Activation::leaky_relu, false, repeated}, conv1_->output_desc(), context);
   conv2_->release_scratch(arena);
@@ -46,7 +47,8 @@ Refinement::Refinement(const RefineWeights& w, int h, int width, int iterations,
 
 void Refinement::begin(dnnl::stream& stream, const Tensor& context) {
   copy_channels(all_channels(context), constant_, 0);
-  for (std::size_t p = 0; p < constant_.pixels(); ++p) constant_.data[p * constant_.c + kContextChannels] = kCorrRadiusPlane;
+  for (std::size_t p = 0; p < constant_.pixels(); ++p)
+    constant_.data[p * constant_.c + kContextChannels] = kCorrRadiusPlane;
   conv1_constant_->run(stream, wrap_nhwc(constant_));
   for (std::size_t p = 0; p < input_.pixels(); ++p) {
     std::fill_n(input_.data.data() + p * input_.c + kRefineHiddenOffset, kHiddenChannels, 0.f);

@@ -36,7 +36,8 @@ void ScaleMerge::merge_features(dnnl::stream& stream, const ChannelSlice& featur
                                 int frame) {
   copy_channels(feature8, feature_input_, 0);
   upsample_nearest_2x(feature16, feature_input_, feature8.channels);
-  merge2_->run_to_nhwc(stream, merge0_->run(stream, wrap_nhwc(feature_input_)), features_[static_cast<std::size_t>(frame)]);
+  merge2_->run_to_nhwc(stream, merge0_->run(stream, wrap_nhwc(feature_input_)),
+                       features_[static_cast<std::size_t>(frame)]);
   stream.wait();
 }
 

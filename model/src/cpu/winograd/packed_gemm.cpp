@@ -43,15 +43,15 @@ void kernel_portable(const float* a, int depth, const float* b, float* c, int ld
 
 // The accumulators are named variables, not an array, so the compiler keeps every one in a
 // register across the depth loop (an array was spilled to the stack at each step).
-#define NEUFLOW_ROW_AVX2(r)                              \
-  {                                                      \
-    const __m256 x = _mm256_broadcast_ss(a + (r) * depth + k); \
-    c##r##0 = _mm256_fmadd_ps(x, b0, c##r##0);           \
-    c##r##1 = _mm256_fmadd_ps(x, b1, c##r##1);           \
+#define NEUFLOW_ROW_AVX2(r)                                  \
+  {                                                          \
+    const __m256 x = _mm256_broadcast_ss(a + (r)*depth + k); \
+    c##r##0 = _mm256_fmadd_ps(x, b0, c##r##0);               \
+    c##r##1 = _mm256_fmadd_ps(x, b1, c##r##1);               \
   }
-#define NEUFLOW_STORE_AVX2(r)                          \
-  _mm256_storeu_ps(c + (r) * ldc, c##r##0);            \
-  _mm256_storeu_ps(c + (r) * ldc + 8, c##r##1);
+#define NEUFLOW_STORE_AVX2(r)             \
+  _mm256_storeu_ps(c + (r)*ldc, c##r##0); \
+  _mm256_storeu_ps(c + (r)*ldc + 8, c##r##1);
 
 // AVX2/FMA: 6 rows × 16 columns in 12 registers; per step two panel loads, six broadcasts and
 // twelve FMAs, so the FMA units set the pace.
@@ -61,22 +61,22 @@ __attribute__((target("avx2,fma"))) void kernel_avx2(const float* a, int depth, 
   for (int k = 0; k < depth; ++k) {
     const __m256 b0 = _mm256_loadu_ps(b + 16 * k);
     const __m256 b1 = _mm256_loadu_ps(b + 16 * k + 8);
-    NEUFLOW_ROW_AVX2(0) NEUFLOW_ROW_AVX2(1) NEUFLOW_ROW_AVX2(2) NEUFLOW_ROW_AVX2(3) NEUFLOW_ROW_AVX2(4)
-    NEUFLOW_ROW_AVX2(5)
+    NEUFLOW_ROW_AVX2(0)
+    NEUFLOW_ROW_AVX2(1) NEUFLOW_ROW_AVX2(2) NEUFLOW_ROW_AVX2(3) NEUFLOW_ROW_AVX2(4) NEUFLOW_ROW_AVX2(5)
   }
-  NEUFLOW_STORE_AVX2(0) NEUFLOW_STORE_AVX2(1) NEUFLOW_STORE_AVX2(2) NEUFLOW_STORE_AVX2(3) NEUFLOW_STORE_AVX2(4)
-  NEUFLOW_STORE_AVX2(5)
+  NEUFLOW_STORE_AVX2(0)
+  NEUFLOW_STORE_AVX2(1) NEUFLOW_STORE_AVX2(2) NEUFLOW_STORE_AVX2(3) NEUFLOW_STORE_AVX2(4) NEUFLOW_STORE_AVX2(5)
 }
 
-#define NEUFLOW_ROW_AVX512(r)                       \
-  {                                                 \
-    const __m512 x = _mm512_set1_ps(a[(r) * depth + k]); \
-    c##r##0 = _mm512_fmadd_ps(x, b0, c##r##0);      \
-    c##r##1 = _mm512_fmadd_ps(x, b1, c##r##1);      \
+#define NEUFLOW_ROW_AVX512(r)                          \
+  {                                                    \
+    const __m512 x = _mm512_set1_ps(a[(r)*depth + k]); \
+    c##r##0 = _mm512_fmadd_ps(x, b0, c##r##0);         \
+    c##r##1 = _mm512_fmadd_ps(x, b1, c##r##1);         \
   }
-#define NEUFLOW_STORE_AVX512(r)                     \
-  _mm512_storeu_ps(c + (r) * ldc, c##r##0);         \
-  _mm512_storeu_ps(c + (r) * ldc + 16, c##r##1);
+#define NEUFLOW_STORE_AVX512(r)           \
+  _mm512_storeu_ps(c + (r)*ldc, c##r##0); \
+  _mm512_storeu_ps(c + (r)*ldc + 16, c##r##1);
 
 // AVX-512: 8 rows × 32 columns in 16 of the 32 registers; per step two panel loads, eight
 // broadcasts (folded into the FMAs) and sixteen FMAs.
@@ -86,11 +86,16 @@ __attribute__((target("avx512f"))) void kernel_avx512(const float* a, int depth,
   for (int k = 0; k < depth; ++k) {
     const __m512 b0 = _mm512_loadu_ps(b + 32 * k);
     const __m512 b1 = _mm512_loadu_ps(b + 32 * k + 16);
+    // The rows as a table: clang-format does not settle on one layout of them.
+    // clang-format off
     NEUFLOW_ROW_AVX512(0) NEUFLOW_ROW_AVX512(1) NEUFLOW_ROW_AVX512(2) NEUFLOW_ROW_AVX512(3)
     NEUFLOW_ROW_AVX512(4) NEUFLOW_ROW_AVX512(5) NEUFLOW_ROW_AVX512(6) NEUFLOW_ROW_AVX512(7)
+    // clang-format on
   }
+  // clang-format off
   NEUFLOW_STORE_AVX512(0) NEUFLOW_STORE_AVX512(1) NEUFLOW_STORE_AVX512(2) NEUFLOW_STORE_AVX512(3)
   NEUFLOW_STORE_AVX512(4) NEUFLOW_STORE_AVX512(5) NEUFLOW_STORE_AVX512(6) NEUFLOW_STORE_AVX512(7)
+  // clang-format on
 }
 
 #undef NEUFLOW_ROW_AVX2

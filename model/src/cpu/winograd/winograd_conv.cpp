@@ -10,9 +10,9 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
-#include <stdexcept>
 
 #include "winograd/packed_gemm.hpp"
 #include "winograd/winograd_f43.hpp"
@@ -96,7 +96,8 @@ std::vector<float> transform_filters(const ConvWeights& w, const GemmKernel& ker
 ConvWeights space_to_depth_filters(const ConvWeights& w, int s) {
   if (s == 1) return w;
   const int c_in = w.in_channels, k = w.kernel_h, depth = c_in * s * s;
-  ConvWeights r{w.out_channels, depth, 3, 3, std::vector<float>(static_cast<std::size_t>(w.out_channels) * depth * 9), w.bias};
+  ConvWeights r{w.out_channels, depth, 3, 3, std::vector<float>(static_cast<std::size_t>(w.out_channels) * depth * 9),
+                w.bias};
   for (int o = 0; o < w.out_channels; ++o) {
     for (int phase = 0; phase < s * s; ++phase) {
       for (int c = 0; c < c_in; ++c) {
@@ -134,9 +135,9 @@ std::shared_ptr<const std::vector<float>> shared_filters(const ConvWeights& w, c
   auto& entry = cache[key];
   if (auto filters = entry.lock()) return filters;
   const ConvWeights w3 = space_to_depth_filters(w, stride);
-  auto filters = std::make_shared<const std::vector<float>>(
-      tile == WinogradTile::f6x6 ? transform_filters<F63>(w3, kernel, depth, columns)
-                                 : transform_filters<F43>(w3, kernel, depth, columns));
+  auto filters = std::make_shared<const std::vector<float>>(tile == WinogradTile::f6x6
+                                                                ? transform_filters<F63>(w3, kernel, depth, columns)
+                                                                : transform_filters<F43>(w3, kernel, depth, columns));
   entry = filters;
   return filters;
 }
@@ -205,9 +206,8 @@ bool WinogradConv::handles(const ConvWeights& w, const ConvParams& p, int height
   return p.stride == 1 || (w.in_channels % kLanes == 0 && height % p.stride == 0 && width % p.stride == 0);
 }
 
-WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height, int width,
-                           ChannelLayout input_layout, ChannelLayout output_layout, WinogradTile tile,
-                           ScratchArena& arena)
+WinogradConv::WinogradConv(const ConvWeights& w, const ConvParams& p, int height, int width, ChannelLayout input_layout,
+                           ChannelLayout output_layout, WinogradTile tile, ScratchArena& arena)
     : tile_(tile),
       output_tile_(output_tile_of(tile)),
       points_(points_of(tile)),
@@ -302,11 +302,14 @@ template <typename T>
 void WinogradConv::transform_outputs(const float* products, int first, int count, const float* addend,
                                      float* output) const {
   switch (activation_) {
-    case Activation::none: return transform_outputs_as<T, Activation::none>(products, first, count, addend, output);
+    case Activation::none:
+      return transform_outputs_as<T, Activation::none>(products, first, count, addend, output);
     case Activation::leaky_relu:
       return transform_outputs_as<T, Activation::leaky_relu>(products, first, count, addend, output);
-    case Activation::relu: return transform_outputs_as<T, Activation::relu>(products, first, count, addend, output);
-    case Activation::gelu: return transform_outputs_as<T, Activation::gelu>(products, first, count, addend, output);
+    case Activation::relu:
+      return transform_outputs_as<T, Activation::relu>(products, first, count, addend, output);
+    case Activation::gelu:
+      return transform_outputs_as<T, Activation::gelu>(products, first, count, addend, output);
   }
 }
 
@@ -377,7 +380,7 @@ void WinogradConv::run_as(const float* input, const float* addend, float* output
       transform_inputs<T>(input, first, count, points);
       for (int xi = 0; xi < kPoints; ++xi) {
         kernel_->run(points + xi * input_stride_,
-                    filters_->data() + static_cast<std::size_t>(xi) * gemm_columns_ * in_channels_,
+                     filters_->data() + static_cast<std::size_t>(xi) * gemm_columns_ * in_channels_,
                      products + xi * product_stride_, rows, in_channels_, gemm_columns_);
       }
       transform_outputs<T>(products, first, count, addend, output);

@@ -28,11 +28,11 @@ struct ChannelPlacement {
     return static_cast<std::size_t>(c / block) * plane + (static_cast<std::size_t>(y) * width + x) * pixel +
            static_cast<std::size_t>(c % block);
   }
-  int channels;      // real channels (blocked layouts hold zeros up to the block's end)
+  int channels;  // real channels (blocked layouts hold zeros up to the block's end)
   int width;
-  int pixel;         // floats from one pixel to the next
-  int block;         // channels stored together per pixel
-  std::size_t plane; // floats from one block of channels to the next
+  int pixel;                // floats from one pixel to the next
+  int block;                // channels stored together per pixel
+  std::size_t plane;        // floats from one block of channels to the next
   bool partial_last_group;  // NHWC with channels not a multiple of 8: the last 8 are partial
 };
 
@@ -49,8 +49,8 @@ class WinogradConv {
 
   // height and width are the input's. Its workspace (the transformed tiles of a block per
   // thread) is a buffer of the arena's current region, alive until released.
-  WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width,
-               ChannelLayout input_layout, ChannelLayout output_layout, WinogradTile tile, ScratchArena& arena);
+  WinogradConv(const ConvWeights& weights, const ConvParams& params, int height, int width, ChannelLayout input_layout,
+               ChannelLayout output_layout, WinogradTile tile, ScratchArena& arena);
 
   WinogradTile tile() const { return tile_; }
 
@@ -76,22 +76,21 @@ class WinogradConv {
   template <typename T>
   void transform_outputs(const float* products, int first_tile, int count, const float* addend, float* output) const;
   template <typename T, Activation A>
-  void transform_outputs_as(const float* products, int first_tile, int count, const float* addend,
-                            float* output) const;
+  void transform_outputs_as(const float* products, int first_tile, int count, const float* addend, float* output) const;
 
   WinogradTile tile_;
   int output_tile_, points_;  // the tile form's output side and points per tile
   int stride_;
-  int height_, width_;       // the output's (the space-to-depth view's)
+  int height_, width_;  // the output's (the space-to-depth view's)
   ChannelPlacement input_, output_;
-  int in_channels_;      // padded to 8
-  int out_channels_;     // padded to the output's block (8 in NHWC): what is written
+  int in_channels_;   // padded to 8
+  int out_channels_;  // padded to the output's block (8 in NHWC): what is written
   const winograd::GemmKernel* kernel_;
-  int gemm_columns_;     // padded to the kernel's panel: the products' width
+  int gemm_columns_;  // padded to the kernel's panel: the products' width
   Activation activation_;
   bool accumulate_;
   int tiles_x_, tiles_;
-  int block_tiles_;      // a multiple of the kernel's rows
+  int block_tiles_;  // a multiple of the kernel's rows
   int blocks_;
   int threads_;
   std::size_t input_stride_, product_stride_;  // floats from one point to the next in a block
@@ -99,7 +98,7 @@ class WinogradConv {
   dnnl::memory workspace_;
   // [points][columns / panel][in_channels][panel], shared by every plan of the same model.
   std::shared_ptr<const std::vector<float>> filters_;
-  std::vector<float> bias_;     // gemm_columns_ values
+  std::vector<float> bias_;  // gemm_columns_ values
 };
 
 }  // namespace neuflow::model

@@ -29,7 +29,7 @@ void transform_filter(const float* filter, float* points) {
   constexpr int n = T::kInputTile;
   double g[9], t[n * 3], p[T::kPoints];
   for (int i = 0; i < 9; ++i) g[i] = filter[i];
-  for (int j = 0; j < 3; ++j) T::filter_1d(g + j, t + j, 3, 3);      // n rows × 3
+  for (int j = 0; j < 3; ++j) T::filter_1d(g + j, t + j, 3, 3);          // n rows × 3
   for (int i = 0; i < n; ++i) T::filter_1d(t + 3 * i, p + n * i, 1, 1);  // n × n
   for (int i = 0; i < T::kPoints; ++i) points[i] = static_cast<float>(p[i]);
 }

@@ -3,7 +3,7 @@
 namespace neuflow::pipeline {
 
 struct FrameRate {
-  int numerator = 0;    // 0: unknown or variable
+  int numerator = 0;  // 0: unknown or variable
   int denominator = 1;
 
   bool known() const { return numerator > 0 && denominator > 0; }

@@ -26,10 +26,10 @@ struct VideoMode {
   bool operator==(const VideoMode&) const = default;
 };
 
-struct V4l2Source {       // type = "v4l2"
+struct V4l2Source {  // type = "v4l2"
   std::string device = "/dev/video0";
   VideoMode mode;
-  bool mjpeg = false;     // `format = "mjpeg"`: ask the camera for JPEG and decode it
+  bool mjpeg = false;  // `format = "mjpeg"`: ask the camera for JPEG and decode it
   bool operator==(const V4l2Source&) const = default;
 };
 
@@ -39,12 +39,12 @@ struct LibcameraSource {  // type = "libcamera"
   bool operator==(const LibcameraSource&) const = default;
 };
 
-struct UriSource {        // type = "uri"
-  std::string uri;        // file://, rtsp://, http(s)://; a plain path in the file is made a file:// URI
+struct UriSource {  // type = "uri"
+  std::string uri;  // file://, rtsp://, http(s)://; a plain path in the file is made a file:// URI
   bool operator==(const UriSource&) const = default;
 };
 
-struct TestSource {       // type = "test"
+struct TestSource {              // type = "test"
   std::string pattern = "ball";  // a videotestsrc pattern nick
   VideoMode mode;                // defaults applied by the graph: 320x240 at 30/1
   int frames = -1;               // `frames = N`: end of stream after N frames; -1: endless
@@ -65,36 +65,36 @@ struct FlowStage {
 
 // ---- sinks ---------------------------------------------------------------------------------
 
-struct FilesSink {        // type = "files"
-  std::filesystem::path directory;    // required; created if missing
-  std::string format = "flo";         // flo | npy | png
-  std::uint64_t max_files = 0;        // max-files: oldest removed first; 0 = no limit
-  std::uint64_t max_bytes = 0;        // max-bytes: same, by total size; 0 = no limit
+struct FilesSink {                  // type = "files"
+  std::filesystem::path directory;  // required; created if missing
+  std::string format = "flo";       // flo | npy | png
+  std::uint64_t max_files = 0;      // max-files: oldest removed first; 0 = no limit
+  std::uint64_t max_bytes = 0;      // max-bytes: same, by total size; 0 = no limit
   bool operator==(const FilesSink&) const = default;
 };
 
-struct ShmSink {          // type = "shm"
-  std::string name;       // POSIX shm name, e.g. "/neuflow-front" (required, leading '/')
-  int slots = 4;          // the latest N flows
-  unsigned mode = 0640;   // shm-mode = "0640" (or 0o640): the segment's permissions
+struct ShmSink {         // type = "shm"
+  std::string name;      // POSIX shm name, e.g. "/neuflow-front" (required, leading '/')
+  int slots = 4;         // the latest N flows
+  unsigned mode = 0640;  // shm-mode = "0640" (or 0o640): the segment's permissions
   bool operator==(const ShmSink&) const = default;
 };
 
 // The encoded (H.264) colour visualization. Exactly one of `file`, `rtsp`, `udp` is given.
-struct VideoSink {        // type = "video"
+struct VideoSink {  // type = "video"
   enum class Target { file, rtsp, udp };
   Target target = Target::file;
-  std::filesystem::path file;         // file = ".../viz-%05d.mp4" (.mp4 or .mkv)
-  int segment_seconds = 0;            // segment-seconds: a new file every N s; 0 = one file
-  std::string rtsp_mount;             // rtsp = "/front": a mount on the [rtsp] server
-  std::string udp_host;               // udp = "192.168.1.10:5000": RTP/H.264 over UDP
+  std::filesystem::path file;  // file = ".../viz-%05d.mp4" (.mp4 or .mkv)
+  int segment_seconds = 0;     // segment-seconds: a new file every N s; 0 = one file
+  std::string rtsp_mount;      // rtsp = "/front": a mount on the [rtsp] server
+  std::string udp_host;        // udp = "192.168.1.10:5000": RTP/H.264 over UDP
   int udp_port = 0;
-  int bitrate_kbps = 2000;            // bitrate (kbit/s)
-  double max_flow = 20.0;             // max-flow: px of full colour saturation
+  int bitrate_kbps = 2000;  // bitrate (kbit/s)
+  double max_flow = 20.0;   // max-flow: px of full colour saturation
   bool operator==(const VideoSink&) const = default;
 };
 
-struct DisplaySink {      // type = "display": a window, for debugging
+struct DisplaySink {  // type = "display": a window, for debugging
   double max_flow = 20.0;
   bool operator==(const DisplaySink&) const = default;
 };

@@ -16,13 +16,13 @@
 namespace neuflow::pipeline {
 
 struct SourcePlan {
-  ElementChain chain;   // linked in order; its last element feeds the flow stage
+  ElementChain chain;    // linked in order; its last element feeds the flow stage
   bool dynamic = false;  // the first element (uridecodebin) links its video pad once typed
 };
 
 struct SinkPlan {
-  std::string_view kind;  // sink_kind()
-  ElementChain chain;     // starts with the branch's queue
+  std::string_view kind;                       // sink_kind()
+  ElementChain chain;                          // starts with the branch's queue
   std::vector<std::filesystem::path> folders;  // to exist before the chain is built
 };
 

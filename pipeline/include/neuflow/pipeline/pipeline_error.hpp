@@ -10,12 +10,12 @@ namespace neuflow::pipeline {
 class PipelineError : public std::runtime_error {
  public:
   enum class Kind {
-    not_found,        // the input file does not exist or cannot be read
-    undecodable,      // GStreamer cannot decode it, or it has no video stream
-    missing_element,  // a GStreamer element this needs is not installed
-    write_failed,     // the output (or its temporary sibling) could not be written
-    invalid_argument, // the caller asked for something unusable (size, extension…)
-    failed,           // anything else GStreamer reported
+    not_found,         // the input file does not exist or cannot be read
+    undecodable,       // GStreamer cannot decode it, or it has no video stream
+    missing_element,   // a GStreamer element this needs is not installed
+    write_failed,      // the output (or its temporary sibling) could not be written
+    invalid_argument,  // the caller asked for something unusable (size, extension…)
+    failed,            // anything else GStreamer reported
   };
 
   PipelineError(Kind kind, std::string subject, const std::string& problem);

@@ -22,13 +22,13 @@
 namespace neuflow::pipeline {
 
 struct SinkBranch {
-  std::string name;               // NamedSink::name
-  std::string kind;               // sink_kind(): "files", "shm", "video-file", "rtsp", "udp", "display"
-  GstElement* bin = nullptr;      // our reference; in the pipeline until removed
-  GstPad* tee_pad = nullptr;      // our reference to the tee's request pad
-  GstElement* writer = nullptr;   // the element counting "flows-written" (files, shm), or null; in `bin`
+  std::string name;              // NamedSink::name
+  std::string kind;              // sink_kind(): "files", "shm", "video-file", "rtsp", "udp", "display"
+  GstElement* bin = nullptr;     // our reference; in the pipeline until removed
+  GstPad* tee_pad = nullptr;     // our reference to the tee's request pad
+  GstElement* writer = nullptr;  // the element counting "flows-written" (files, shm), or null; in `bin`
   std::atomic<bool> failed{false};
-  bool removed = false;           // taken out of the pipeline after failing (main thread only)
+  bool removed = false;  // taken out of the pipeline after failing (main thread only)
 };
 
 // A sink that could not be built when the pipeline was; the stream runs without it.

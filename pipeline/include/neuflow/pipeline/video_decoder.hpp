@@ -18,8 +18,8 @@ namespace neuflow::pipeline {
 struct RgbFrame {
   int width = 0;
   int height = 0;
-  std::vector<std::uint8_t> rgb;  // 3 * width * height
-  std::int64_t number = 0;        // 0-based position in the decoded stream
+  std::vector<std::uint8_t> rgb;       // 3 * width * height
+  std::int64_t number = 0;             // 0-based position in the decoded stream
   std::optional<std::int64_t> pts_ns;  // presentation timestamp, when the stream has one
 };
 

@@ -25,23 +25,23 @@ G_BEGIN_DECLS
 typedef struct {
   GstMeta meta;
 
-  guint width;        /* flow grid size */
+  guint width; /* flow grid size */
   guint height;
-  GBytes *data;       /* width * height * 2 float32: u, v interleaved, row-major */
+  GBytes *data; /* width * height * 2 float32: u, v interleaved, row-major */
 
-  guint frame_width;  /* the frame the grid covers */
+  guint frame_width; /* the frame the grid covers */
   guint frame_height;
 
-  GstClockTime from_pts;  /* timestamp of the frame the flow starts at */
-  GstClockTime to_pts;    /* timestamp of the frame the flow ends at (normally this buffer's) */
-  guint64 from_frame;     /* frame numbers as counted by the element (0-based, all frames in) */
+  GstClockTime from_pts; /* timestamp of the frame the flow starts at */
+  GstClockTime to_pts;   /* timestamp of the frame the flow ends at (normally this buffer's) */
+  guint64 from_frame;    /* frame numbers as counted by the element (0-based, all frames in) */
   guint64 to_frame;
 
-  guint model_width;  /* the resolution the network ran at */
+  guint model_width; /* the resolution the network ran at */
   guint model_height;
-  guint iters_s16;    /* refinement iterations at 1/16 and 1/8 */
+  guint iters_s16; /* refinement iterations at 1/16 and 1/8 */
   guint iters_s8;
-  GstClockTime inference_time;  /* wall time of the computation */
+  GstClockTime inference_time; /* wall time of the computation */
 } NeuflowFlowMeta;
 
 GType neuflow_flow_meta_api_get_type(void);

@@ -37,7 +37,7 @@ struct EvalProgress {
 };
 
 struct EvaluateOptions {
-  std::size_t max_pairs = 0;  // score only the first N pairs of the set; 0: all
+  std::size_t max_pairs = 0;                          // score only the first N pairs of the set; 0: all
   std::function<void(const EvalProgress&)> progress;  // after every pair, if set
   // Every pair's prediction and ground truth once scored (--save-viz), if set.
   std::function<void(const EvalSet&, const Pair&, const flow::FlowField& predicted,
