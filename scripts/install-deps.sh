@@ -29,6 +29,7 @@ packages=(
   systemd                           # systemd-analyze verify of the unit files
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev libomp-14-dev llvm-14   # libFuzzer harnesses (tests/fuzz), llvm-symbolizer
+  clang-format-14 clang-tidy-14     # CI's first stage: .clang-format, .clang-tidy
   g++-11                            # JetPack 6's compiler: CI compiles the core with it
   python3 python3-numpy             # tests check that numpy reads our .npy files
 )

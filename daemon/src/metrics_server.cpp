@@ -62,10 +62,9 @@ std::string host_port(const std::string& host, int port) {
 // GLib words bind errors as "Error binding to address 127.0.0.1:9464: Address already in use";
 // the address is already in our message, so only the reason after the last ": " is kept.
 std::string bind_reason(const GError* error) {
-  const std::string message = error->message;
+  std::string message = error->message;
   const auto colon = message.rfind(": ");
-  if (message.rfind("Error binding to address", 0) == 0 && colon != std::string::npos)
-    return message.substr(colon + 2);
+  if (message.rfind("Error binding to address", 0) == 0 && colon != std::string::npos) return message.substr(colon + 2);
   return message;
 }
 

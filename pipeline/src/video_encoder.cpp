@@ -36,7 +36,8 @@ constexpr FrameRate kDefaultRate{25, 1};
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
 
@@ -58,14 +59,15 @@ std::filesystem::path create_temporary_sibling(const std::filesystem::path& path
   for (int attempt = 0; attempt < 16; ++attempt) {
     const std::string name = "." + path.filename().string() + ".partial-" + std::to_string(::getpid()) + "-" +
                              std::to_string(counter.fetch_add(1));
-    const auto temp = dir / name;
+    auto temp = dir / name;
     const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd >= 0) {
       ::close(fd);
       return temp;
     }
     if (errno != EEXIST) {
-      throw PipelineError(Kind::write_failed, path.string(), "cannot create a file in " + dir.string() + ": " + errno_text(errno));
+      throw PipelineError(Kind::write_failed, path.string(),
+                          "cannot create a file in " + dir.string() + ": " + errno_text(errno));
     }
   }
   throw PipelineError(Kind::write_failed, path.string(), "cannot create a temporary file in " + dir.string());
@@ -158,8 +160,8 @@ VideoEncoder::VideoEncoder(std::filesystem::path path, int width, int height, Fr
   gst_util_set_object_arg(G_OBJECT(encoder), "speed-preset", "veryfast");
 
   if (!gst_element_link_many(s.src, convert, filter, encoder, parser, mux, sink, nullptr)) {
-    throw PipelineError(Kind::failed, subject, std::string("cannot link the encoding pipeline (x264enc ! h264parse ! ") +
-                                                   muxer + ")");
+    throw PipelineError(Kind::failed, subject,
+                        std::string("cannot link the encoding pipeline (x264enc ! h264parse ! ") + muxer + ")");
   }
   s.temp = create_temporary_sibling(s.path);
   g_object_set(sink, "location", s.temp.c_str(), nullptr);
@@ -210,7 +212,8 @@ GstBuffer* VideoEncoder::Impl::to_buffer(const flow::RgbImage& frame) const {
 
 void VideoEncoder::write(const flow::RgbImage& frame) {
   auto& s = *impl_;
-  if (s.done) throw PipelineError(Kind::invalid_argument, s.path.string(), "the encoder has already finished or failed");
+  if (s.done)
+    throw PipelineError(Kind::invalid_argument, s.path.string(), "the encoder has already finished or failed");
   if (frame.width != s.width || frame.height != s.height ||
       frame.rgb.size() != 3 * static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height)) {
     throw PipelineError(Kind::invalid_argument, s.path.string(),
@@ -239,13 +242,15 @@ void VideoEncoder::write(const flow::RgbImage& frame) {
 
 void VideoEncoder::finish() {
   auto& s = *impl_;
-  if (s.done) throw PipelineError(Kind::invalid_argument, s.path.string(), "the encoder has already finished or failed");
+  if (s.done)
+    throw PipelineError(Kind::invalid_argument, s.path.string(), "the encoder has already finished or failed");
   if (s.frames == 0) s.fail(Kind::invalid_argument, "no frames to encode");
   gst_app_src_end_of_stream(GST_APP_SRC(s.src));
   // The muxer writes its index (the MP4 moov) when end of stream reaches it.
   GstMessage* message = gst_bus_timed_pop_filtered(s.bus.get(), kFinishTimeout,
                                                    static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
-  if (!message) s.fail(Kind::failed, "the encoder did not finish within " + std::to_string(kFinishTimeout / GST_SECOND) + " s");
+  if (!message)
+    s.fail(Kind::failed, "the encoder did not finish within " + std::to_string(kFinishTimeout / GST_SECOND) + " s");
   if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR) {
     gst_bus_post(s.bus.get(), message);  // the bus takes it; fail_on_bus_error parses it
     s.fail_on_bus_error();
