@@ -154,9 +154,21 @@ class VulkanNetwork::Recorder {
   // out = act(conv(in) + bias (+ addend)); out.c must be the layer's output channels.
   void conv(const DeviceConv& w, const View& in, int stride, int pad, Act act, const View& out,
             const View* addend = nullptr) {
-    const Conv2dParams p{in.c,  in.h,  in.w,         in.offset(), out.c,
-                         out.h, out.w, out.offset(), w.kernel,    stride,
-                         pad,   act,   w.weight,     w.bias,      addend ? addend->offset() : -1,
+    const Conv2dParams p{in.c,
+                         in.h,
+                         in.w,
+                         in.offset(),
+                         out.c,
+                         out.h,
+                         out.w,
+                         out.offset(),
+                         w.kernel_h,
+                         stride,
+                         pad,
+                         act,
+                         w.weight.offset,
+                         w.bias.offset,
+                         addend ? addend->offset() : -1,
                          1.f};
     dispatch<Shader::conv2d>({&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, p,
                              tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
@@ -165,11 +177,11 @@ class VulkanNetwork::Recorder {
   // Token lists [features][tokens]: out = act(W · in + b).
   void linear(const DeviceLinear& w, const Buffer& in, int in_off, const Buffer& out, int out_off, int tokens,
               Act act = kActNone) {
-    const MatmulParams p{w.out_features, tokens,        w.in_features,
-                         w.weight,       w.in_features, 1,
-                         in_off,         tokens,        1,
-                         out_off,        tokens,        1,
-                         w.bias,         act,           1.f};
+    const MatmulParams p{w.out_features,  tokens,        w.in_features,
+                         w.weight.offset, w.in_features, 1,
+                         in_off,          tokens,        1,
+                         out_off,         tokens,        1,
+                         w.bias.offset,   act,           1.f};
     dispatch<Shader::matmul>({&net_.weights_->buffer, &in, &out, nullptr}, p, tiles(tokens, "attention"),
                              tiles(w.out_features, "attention"));
   }
@@ -653,7 +665,7 @@ void VulkanNetwork::record_attention_layer(Recorder& r, const DeviceAttentionLay
   r.linear(w.merge, message_, 0, attn_tmp_, 0, l);
   const auto layer_norm = [&](const DeviceLayerNorm& nw, const Buffer& x, const Buffer& dst, int dst_off,
                               const Buffer* residual) {
-    const LayerNormParams p{kDim, l, 0, dst_off, residual ? 0 : -1, nw.gamma, nw.beta};
+    const LayerNormParams p{kDim, l, 0, dst_off, residual ? 0 : -1, nw.gamma.offset, nw.beta.offset};
     r.dispatch<Shader::layer_norm>({&weights_->buffer, &x, &dst, residual}, p, groups(l, kLocal));
   };
   // mlp input = concat[src, LayerNorm1(merge(message))]
@@ -719,7 +731,7 @@ void VulkanNetwork::record_flow(Recorder& r, int slot0, int slot1, const Iterati
   record_attention_layer(r, wt.attention[1], state0_, state1_, attended_[0]);
   record_attention_layer(r, wt.attention[1], state1_, state0_, attended_[1]);
   for (const auto& a : attended_) {
-    const ChannelAffineParams p{kDim, l, 0, wt.attention_norm_scale, wt.attention_norm_shift};
+    const ChannelAffineParams p{kDim, l, 0, wt.attention_norm_scale.offset, wt.attention_norm_shift.offset};
     r.dispatch<Shader::channel_affine>({&wt.buffer, nullptr, &a, nullptr}, p, groups(kDim * l, kLocal));
   }
   const View att0{&attended_[0], 0, kDim, h16_, w16_}, att1{&attended_[1], 0, kDim, h16_, w16_};
