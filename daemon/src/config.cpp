@@ -111,17 +111,8 @@ pipeline::GraphDescription graph_description(const StreamConfig& stream, int thr
   pipeline::GraphDescription graph;
   graph.name = stream.name;
   graph.source = stream.source.settings;
-  const FlowConfig& f = stream.flow;
-  graph.flow.model = f.model;
-  graph.flow.session.iterations = {f.iters_s16, f.iters_s8};
-  graph.flow.session.model_width = f.model_width;
-  graph.flow.session.model_height = f.model_height;
+  graph.flow = stream.flow.stage;
   graph.flow.session.threads = threads;
-  graph.flow.session.network_order = model::parse_channel_order(f.channel_order).value_or(model::ChannelOrder::rgb);
-  graph.flow.session.backend = model::parse_backend(f.backend).value_or(model::Backend::automatic);
-  graph.flow.session.device = f.device;
-  graph.flow.session.precision = model::parse_precision(f.precision).value_or(model::Precision::fp32);
-  graph.flow.behaviour = f.behaviour;
   for (const SinkConfig& sink : stream.sinks) graph.sinks.push_back({sink.name, sink.settings});
   return graph;
 }

@@ -42,20 +42,12 @@ struct SourceConfig {
 
 // ---- flow ----------------------------------------------------------------------------------
 
-// The neuflow element's properties, under the same names in the file (the graph's FlowStage:
-// flow_stage()).
+// The neuflow element's properties, under the same names in the file, read straight into the
+// graph's typed flow stage: model, iters-s16, iters-s8, model-width, model-height, threads,
+// behaviour, channel-order, backend, device, precision. stage.session.threads = 0 means an
+// equal share of [daemon] threads, resolved per stream when the graph is made.
 struct FlowConfig {
-  std::filesystem::path model;              // model = "/var/lib/neuflow/neuflow_mixed.pth" (required)
-  int iters_s16 = model::Iterations{}.s16;  // iters-s16
-  int iters_s8 = model::Iterations{}.s8;    // iters-s8
-  int model_width = 0;                      // model-width / model-height: 0 = the frames' own size
-  int model_height = 0;
-  int threads = 0;                    // 0: an equal share of [daemon] threads
-  std::string behaviour = "auto";     // auto | live | every-pair
-  std::string channel_order = "rgb";  // rgb | bgr
-  std::string backend = "auto";       // auto | cpu | vulkan
-  int device = -1;                    // Vulkan device index; -1: the first GPU
-  std::string precision = "fp32";     // fp32 | fp16
+  pipeline::FlowStage stage;
   SourcePosition where;
   bool operator==(const FlowConfig&) const = default;
 };

@@ -241,18 +241,10 @@ GstInventory installed_gstreamer() {
 void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Issues& issues, Issues& errors) {
   for (const auto& need : needs.paths) {
     switch (need.kind) {
-      case PathNeed::Kind::readable_file:
-        check_readable_file(need, issues);
-        break;
-      case PathNeed::Kind::checkpoint:
-        check_checkpoint(need, issues, errors);
-        break;
-      case PathNeed::Kind::video_device:
-        check_video_device(need, issues);
-        break;
-      case PathNeed::Kind::writable_directory:
-        check_writable_directory(need, issues);
-        break;
+      case PathNeed::Kind::readable_file: check_readable_file(need, issues); break;
+      case PathNeed::Kind::checkpoint: check_checkpoint(need, issues, errors); break;
+      case PathNeed::Kind::video_device: check_video_device(need, issues); break;
+      case PathNeed::Kind::writable_directory: check_writable_directory(need, issues); break;
     }
   }
   check_elements(needs.elements, gstreamer, issues);

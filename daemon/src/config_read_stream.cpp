@@ -4,6 +4,7 @@
 
 #include "config_read.hpp"
 #include "config_values.hpp"
+#include "neuflow/model/session_option_docs.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/pipeline/graph_plan.hpp"
 
@@ -16,17 +17,34 @@ using SessionLimits = model::SessionLimits;
 }  // namespace
 
 FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContext& context) {
-  static constexpr std::array<std::string_view, 11> keys = {"model",        "iters-s16", "iters-s8",  "model-width",
-                                                            "model-height", "threads",   "behaviour", "channel-order",
-                                                            "backend",      "device",    "precision"};
-  static constexpr std::array<std::string_view, 2> precisions = {"fp32", "fp16"};
-  static constexpr std::array<std::string_view, 3> backends = {"auto", "cpu", "vulkan"};
-  static constexpr std::array<std::string_view, 3> behaviours = {"auto", "live", "every-pair"};
-  static constexpr std::array<std::string_view, 2> orders = {model::channel_order_name(model::ChannelOrder::rgb),
-                                                             model::channel_order_name(model::ChannelOrder::bgr)};
+  namespace docs = model::option_docs;
+  // The element's property names (option_docs), which the command's options share.
+  static constexpr std::array<std::string_view, 11> keys = {"model",
+                                                            docs::iters_s16.name,
+                                                            docs::iters_s8.name,
+                                                            docs::model_width.name,
+                                                            docs::model_height.name,
+                                                            docs::threads.name,
+                                                            docs::behaviour.name,
+                                                            docs::channel_order.name,
+                                                            docs::backend.name,
+                                                            docs::device.name,
+                                                            docs::precision.name};
+  using model::Backend, model::Behaviour, model::ChannelOrder, model::Precision;
+  static constexpr std::array<std::string_view, 2> precisions = {model::precision_name(Precision::fp32),
+                                                                 model::precision_name(Precision::fp16)};
+  static constexpr std::array<std::string_view, 3> backends = {
+      model::backend_name(Backend::automatic), model::backend_name(Backend::cpu), model::backend_name(Backend::vulkan)};
+  static constexpr std::array<std::string_view, 3> behaviours = {model::behaviour_name(Behaviour::automatic),
+                                                                 model::behaviour_name(Behaviour::live),
+                                                                 model::behaviour_name(Behaviour::every_pair)};
+  static constexpr std::array<std::string_view, 2> orders = {model::channel_order_name(ChannelOrder::rgb),
+                                                             model::channel_order_name(ChannelOrder::bgr)};
   t.allow_only(keys);
-  FlowConfig f;
-  f.where = t.where();
+  FlowConfig config;
+  config.where = t.where();
+  pipeline::FlowStage& f = config.stage;
+  model::SessionOptions& session = f.session;
   if (auto model = t.string("model", Need::required)) {
     if (model->empty()) {
       t.report("model", "expected the path of a NeuFlow-V2 checkpoint (.pth), got an empty string");
@@ -34,38 +52,49 @@ FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContex
       f.model = context.need_path(PathNeed::Kind::checkpoint, *model, "model", t.position("model"));
     }
   }
-  if (auto v = t.integer("iters-s16", 0, SessionLimits::max_iterations_s16)) f.iters_s16 = static_cast<int>(*v);
-  if (auto v = t.integer("iters-s8", 0, SessionLimits::max_iterations_s8)) f.iters_s8 = static_cast<int>(*v);
-  const auto width = t.integer("model-width", 0, SessionLimits::max_side);
-  const auto height = t.integer("model-height", 0, SessionLimits::max_side);
+  if (auto v = t.integer(docs::iters_s16.name, 0, SessionLimits::max_iterations_s16)) {
+    session.iterations.s16 = static_cast<int>(*v);
+  }
+  if (auto v = t.integer(docs::iters_s8.name, 0, SessionLimits::max_iterations_s8))
+    session.iterations.s8 = static_cast<int>(*v);
+  const auto width = t.integer(docs::model_width.name, 0, SessionLimits::max_side);
+  const auto height = t.integer(docs::model_height.name, 0, SessionLimits::max_side);
   const auto width_problem = width ? model::check_model_side(static_cast<int>(*width)) : std::nullopt;
   const auto height_problem = height ? model::check_model_side(static_cast<int>(*height)) : std::nullopt;
   if (width_problem) {
-    t.report("model-width", *width_problem);
+    t.report(docs::model_width.name, *width_problem);
   } else if (height_problem) {
-    t.report("model-height", *height_problem);
+    t.report(docs::model_height.name, *height_problem);
   } else if (width && height) {
     if ((*width == 0) != (*height == 0)) {
-      t.report(*width == 0 ? "model-width" : "model-height",
+      t.report(*width == 0 ? docs::model_width.name : docs::model_height.name,
                "model-width and model-height go together: both 0 (the frames' own size) or both set");
     }
-    f.model_width = static_cast<int>(*width);
-    f.model_height = static_cast<int>(*height);
+    session.model_width = static_cast<int>(*width);
+    session.model_height = static_cast<int>(*height);
   } else if ((width && *width != 0) || (height && *height != 0)) {
-    t.report(width ? "model-width" : "model-height",
-             std::string("model-width and model-height go together: add ") + (width ? "model-height" : "model-width"));
+    t.report(width ? docs::model_width.name : docs::model_height.name,
+             "model-width and model-height go together: add " +
+                 std::string(width ? docs::model_height.name : docs::model_width.name));
   }
-  if (auto v = t.integer("threads", 0, SessionLimits::max_threads)) f.threads = static_cast<int>(*v);
-  if (auto v = t.choice("behaviour", behaviours)) f.behaviour = *v;
-  if (auto v = t.choice("channel-order", orders)) f.channel_order = *v;
-  if (auto v = t.choice("backend", backends)) f.backend = *v;
-  if (auto v = t.integer("device", -1, SessionLimits::max_device)) f.device = static_cast<int>(*v);
-  if (auto v = t.choice("precision", precisions)) f.precision = *v;
-  if (f.backend == "vulkan") {
-    context.needs.gpus.push_back(
-        {f.device, "stream '" + stream + "'", t.position(t.has("device") ? "device" : "backend")});
+  if (auto v = t.integer(docs::threads.name, 0, SessionLimits::max_threads)) session.threads = static_cast<int>(*v);
+  // choice() accepts only the listed names, so each parse below succeeds.
+  if (auto v = t.choice(docs::behaviour.name, behaviours))
+    f.behaviour = model::parse_behaviour(*v).value_or(f.behaviour);
+  if (auto v = t.choice(docs::channel_order.name, orders)) {
+    session.network_order = model::parse_channel_order(*v).value_or(session.network_order);
   }
-  return f;
+  if (auto v = t.choice(docs::backend.name, backends))
+    session.backend = model::parse_backend(*v).value_or(session.backend);
+  if (auto v = t.integer(docs::device.name, -1, SessionLimits::max_device)) session.device = static_cast<int>(*v);
+  if (auto v = t.choice(docs::precision.name, precisions)) {
+    session.precision = model::parse_precision(*v).value_or(session.precision);
+  }
+  if (session.backend == Backend::vulkan) {
+    context.needs.gpus.push_back({session.device, "stream '" + stream + "'",
+                                  t.position(t.has(docs::device.name) ? docs::device.name : docs::backend.name)});
+  }
+  return config;
 }
 
 StreamConfig read_stream(const TableReader& t, std::size_t index, ReadContext& context) {

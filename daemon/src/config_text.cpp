@@ -228,8 +228,7 @@ std::optional<TextProblem> check_config_text(std::string_view text) {
         previous = c;
         break;
       }
-      case Context::comment:
-        break;
+      case Context::comment: break;
       case Context::basic_string:
         if (c == '\\' && !ascii_after(i + 1)) {
           ++column;

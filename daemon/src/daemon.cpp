@@ -35,11 +35,11 @@ Daemon::~Daemon() {
 }
 
 int Daemon::threads_for(const StreamConfig& stream) const {
-  if (stream.flow.threads > 0) return stream.flow.threads;
+  if (stream.flow.stage.session.threads > 0) return stream.flow.stage.session.threads;
   const int total = config_.daemon.threads > 0 ? config_.daemon.threads
                                                : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   const auto sharing = std::count_if(config_.streams.begin(), config_.streams.end(),
-                                     [](const StreamConfig& s) { return s.flow.threads == 0; });
+                                     [](const StreamConfig& s) { return s.flow.stage.session.threads == 0; });
   // Each stream's inference runs its own OpenMP team; more threads than cores in total would
   // make the teams fight over them.
   return std::max(1, total / static_cast<int>(std::max<long>(1, sharing)));

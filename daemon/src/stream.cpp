@@ -65,20 +65,13 @@ guint64 uint64_property(GstElement* e, const char* name) {
 
 const char* to_string(StreamState state) {
   switch (state) {
-    case StreamState::idle:
-      return "idle";
-    case StreamState::starting:
-      return "starting";
-    case StreamState::playing:
-      return "playing";
-    case StreamState::backoff:
-      return "backoff";
-    case StreamState::stopping:
-      return "stopping";
-    case StreamState::stopped:
-      return "stopped";
-    case StreamState::finished:
-      return "finished";
+    case StreamState::idle: return "idle";
+    case StreamState::starting: return "starting";
+    case StreamState::playing: return "playing";
+    case StreamState::backoff: return "backoff";
+    case StreamState::stopping: return "stopping";
+    case StreamState::stopped: return "stopped";
+    case StreamState::finished: return "finished";
   }
   return "?";
 }
@@ -325,9 +318,7 @@ void Stream::handle_message(GstMessage* message) {
       fail(branch ? "its only sink " + branch->name + " failed: " + text : text);
       return;
     }
-    case GST_MESSAGE_WARNING:
-      log_warning("stream " + config_.name + ": " + error_text(message));
-      return;
+    case GST_MESSAGE_WARNING: log_warning("stream " + config_.name + ": " + error_text(message)); return;
     case GST_MESSAGE_EOS:
       if (state_ == StreamState::stopping) {
         finish_stop();
@@ -348,8 +339,7 @@ void Stream::handle_message(GstMessage* message) {
       if (new_state == GST_STATE_PLAYING && state_ == StreamState::starting) mark_playing();
       return;
     }
-    default:
-      return;
+    default: return;
   }
 }
 
@@ -468,8 +458,7 @@ std::string Stream::status() const {
     case StreamState::backoff:
       std::snprintf(buf, sizeof buf, "%s retry in %.0f s", config_.name.c_str(), seconds_until_restart());
       break;
-    default:
-      std::snprintf(buf, sizeof buf, "%s %s", config_.name.c_str(), to_string(state_));
+    default: std::snprintf(buf, sizeof buf, "%s %s", config_.name.c_str(), to_string(state_));
   }
   return buf;
 }

@@ -35,12 +35,9 @@ std::optional<FlowFormat> flow_format_from_path(const std::filesystem::path& pat
 
 std::string_view to_string(FlowFormat format) {
   switch (format) {
-    case FlowFormat::flo:
-      return "Middlebury .flo";
-    case FlowFormat::kitti_png:
-      return "KITTI 16-bit PNG";
-    case FlowFormat::npy:
-      return "NumPy .npy";
+    case FlowFormat::flo: return "Middlebury .flo";
+    case FlowFormat::kitti_png: return "KITTI 16-bit PNG";
+    case FlowFormat::npy: return "NumPy .npy";
   }
   return "unknown";
 }
@@ -52,27 +49,18 @@ FlowField read_flow(const std::filesystem::path& path) {
     throw FlowFileError(FlowFileError::Kind::not_found, path, "no such file");
   }
   switch (require_format(path)) {
-    case FlowFormat::flo:
-      return read_flo(path);
-    case FlowFormat::kitti_png:
-      return read_kitti_png(path);
-    case FlowFormat::npy:
-      return read_npy(path);
+    case FlowFormat::flo: return read_flo(path);
+    case FlowFormat::kitti_png: return read_kitti_png(path);
+    case FlowFormat::npy: return read_npy(path);
   }
   return {};  // unreachable: every enumerator is handled above
 }
 
 void write_flow(const FlowField& field, const std::filesystem::path& path) {
   switch (require_format(path)) {
-    case FlowFormat::flo:
-      write_flo(field, path);
-      return;
-    case FlowFormat::kitti_png:
-      write_kitti_png(field, path);
-      return;
-    case FlowFormat::npy:
-      write_npy(field, path);
-      return;
+    case FlowFormat::flo: write_flo(field, path); return;
+    case FlowFormat::kitti_png: write_kitti_png(field, path); return;
+    case FlowFormat::npy: write_npy(field, path); return;
   }
 }
 

@@ -30,18 +30,12 @@ std::uint32_t load_be_u32(const std::byte* p) {
 
 const char* png_color_type_name(int color_type) {
   switch (color_type) {
-    case 0:
-      return "grayscale";
-    case 2:
-      return "RGB";
-    case 3:
-      return "palette";
-    case 4:
-      return "grayscale+alpha";
-    case 6:
-      return "RGBA";
-    default:
-      return "unknown colour type";
+    case 0: return "grayscale";
+    case 2: return "RGB";
+    case 3: return "palette";
+    case 4: return "grayscale+alpha";
+    case 6: return "RGBA";
+    default: return "unknown colour type";
   }
 }
 

@@ -9,20 +9,13 @@ namespace {
 
 double& stage_total(NetworkCost& c, Stage stage) {
   switch (stage) {
-    case Stage::backbone:
-      return c.backbone;
-    case Stage::upsample_features:
-      return c.upsample_features;
-    case Stage::cross_attention:
-      return c.cross_attention;
-    case Stage::merge_s8:
-      return c.merge_s8;
-    case Stage::refine_s16:
-      return c.refine_s16;
-    case Stage::refine_s8:
-      return c.refine_s8;
-    case Stage::upsampler:
-      return c.upsampler;
+    case Stage::backbone: return c.backbone;
+    case Stage::upsample_features: return c.upsample_features;
+    case Stage::cross_attention: return c.cross_attention;
+    case Stage::merge_s8: return c.merge_s8;
+    case Stage::refine_s16: return c.refine_s16;
+    case Stage::refine_s8: return c.refine_s8;
+    case Stage::upsampler: return c.upsampler;
   }
   return c.backbone;
 }
@@ -31,13 +24,10 @@ double& stage_total(NetworkCost& c, Stage stage) {
 double layer_flops(const LayerSpec& layer, int height, int width) {
   const double positions = static_cast<double>(height / layer.scale) * (width / layer.scale);
   switch (layer.kind) {
-    case LayerKind::conv:
-      return 2.0 * positions * layer.out * layer.in * layer.kernel * layer.kernel;
-    case LayerKind::linear:
-      return 2.0 * positions * layer.out * layer.in;
+    case LayerKind::conv: return 2.0 * positions * layer.out * layer.in * layer.kernel * layer.kernel;
+    case LayerKind::linear: return 2.0 * positions * layer.out * layer.in;
     case LayerKind::batch_norm:
-    case LayerKind::layer_norm:
-      return 0;
+    case LayerKind::layer_norm: return 0;
   }
   return 0;
 }

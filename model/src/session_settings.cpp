@@ -88,6 +88,13 @@ std::optional<Backend> parse_backend(std::string_view name) {
   return std::nullopt;
 }
 
+std::optional<Behaviour> parse_behaviour(std::string_view name) {
+  for (const Behaviour b : {Behaviour::automatic, Behaviour::live, Behaviour::every_pair}) {
+    if (name == behaviour_name(b)) return b;
+  }
+  return std::nullopt;
+}
+
 std::optional<CpuConvolution> parse_cpu_convolution(std::string_view name) {
   if (name == "auto") return CpuConvolution::automatic;
   if (name == "direct") return CpuConvolution::direct;

@@ -99,7 +99,7 @@ ElementChain plan_flow(const FlowStage& flow) {
               .set("model-width", std::to_string(s.model_width))
               .set("model-height", std::to_string(s.model_height))
               .set("threads", std::to_string(s.threads))
-              .set("behaviour", flow.behaviour)
+              .set("behaviour", std::string(model::behaviour_name(flow.behaviour)))
               .set("channel-order", std::string(model::channel_order_name(s.network_order)))
               .set("backend", std::string(model::backend_name(s.backend)))
               .set("device", std::to_string(s.device))
@@ -112,12 +112,9 @@ std::string_view sink_kind(const SinkDescription& sink) {
   if (std::holds_alternative<ShmSink>(sink)) return "shm";
   if (std::holds_alternative<DisplaySink>(sink)) return "display";
   switch (std::get<VideoSink>(sink).target) {
-    case VideoSink::Target::file:
-      return "video-file";
-    case VideoSink::Target::rtsp:
-      return "rtsp";
-    case VideoSink::Target::udp:
-      return "udp";
+    case VideoSink::Target::file: return "video-file";
+    case VideoSink::Target::rtsp: return "rtsp";
+    case VideoSink::Target::udp: return "udp";
   }
   return "video";
 }

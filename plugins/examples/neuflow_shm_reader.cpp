@@ -158,17 +158,10 @@ class Follower {
       uv_.resize(reader->values_per_flow());
       ring::FlowInfo info;
       switch (reader->read(next, uv_, info)) {
-        case ring::ReadStatus::ok:
-          report(*reader, info);
-          break;
-        case ring::ReadStatus::overwritten:
-          ++stats_.missed;
-          break;
-        case ring::ReadStatus::torn:
-          ++stats_.torn;
-          break;
-        case ring::ReadStatus::not_published:
-          continue;  // cannot happen for next <= published
+        case ring::ReadStatus::ok: report(*reader, info); break;
+        case ring::ReadStatus::overwritten: ++stats_.missed; break;
+        case ring::ReadStatus::torn: ++stats_.torn; break;
+        case ring::ReadStatus::not_published: continue;  // cannot happen for next <= published
       }
       ++next;
     }

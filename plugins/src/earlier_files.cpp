@@ -43,18 +43,11 @@ std::optional<NamePattern> split(const std::string& name) {
     switch (name[k]) {
       case 'd':
       case 'i':
-      case 'u':
-        p.base = 10;
-        break;
+      case 'u': p.base = 10; break;
       case 'x':
-      case 'X':
-        p.base = 16;
-        break;
-      case 'o':
-        p.base = 8;
-        break;
-      default:
-        return std::nullopt;
+      case 'X': p.base = 16; break;
+      case 'o': p.base = 8; break;
+      default: return std::nullopt;
     }
     p.prefix = unescape_percent(std::string_view(name).substr(0, i));
     p.suffix = unescape_percent(std::string_view(name).substr(k + 1));

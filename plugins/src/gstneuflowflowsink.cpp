@@ -35,18 +35,10 @@ static void gst_neuflow_flow_sink_get_property(GObject *object, guint prop_id, G
   GstNeuflowFlowSinkPrivate *priv = gst_neuflow_flow_sink_private(self);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
-    case PROP_FLOWS_WRITTEN:
-      g_value_set_uint64(value, priv->flows_written);
-      break;
-    case PROP_BYTES_WRITTEN:
-      g_value_set_uint64(value, priv->bytes_written);
-      break;
-    case PROP_BUFFERS_SKIPPED:
-      g_value_set_uint64(value, priv->buffers_skipped);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
+    case PROP_FLOWS_WRITTEN: g_value_set_uint64(value, priv->flows_written); break;
+    case PROP_BYTES_WRITTEN: g_value_set_uint64(value, priv->bytes_written); break;
+    case PROP_BUFFERS_SKIPPED: g_value_set_uint64(value, priv->buffers_skipped); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
 }

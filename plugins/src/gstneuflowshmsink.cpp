@@ -89,15 +89,9 @@ static void gst_neuflow_shm_sink_set_property(GObject *object, guint prop_id, co
       g_free(self->shm_name);
       self->shm_name = g_value_dup_string(value);
       break;
-    case PROP_SLOTS:
-      self->slots = g_value_get_uint(value);
-      break;
-    case PROP_SHM_MODE:
-      self->shm_mode = g_value_get_uint(value);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
+    case PROP_SLOTS: self->slots = g_value_get_uint(value); break;
+    case PROP_SHM_MODE: self->shm_mode = g_value_get_uint(value); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -106,18 +100,10 @@ static void gst_neuflow_shm_sink_get_property(GObject *object, guint prop_id, GV
   GstNeuflowShmSink *self = GST_NEUFLOW_SHM_SINK(object);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
-    case PROP_SHM_NAME:
-      g_value_set_string(value, self->shm_name);
-      break;
-    case PROP_SLOTS:
-      g_value_set_uint(value, self->slots);
-      break;
-    case PROP_SHM_MODE:
-      g_value_set_uint(value, self->shm_mode);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
+    case PROP_SHM_NAME: g_value_set_string(value, self->shm_name); break;
+    case PROP_SLOTS: g_value_set_uint(value, self->slots); break;
+    case PROP_SHM_MODE: g_value_set_uint(value, self->shm_mode); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
 }

@@ -180,22 +180,14 @@ static void gst_neuflow_sink_set_property(GObject *object, guint prop_id, const 
       g_free(self->location);
       self->location = g_value_dup_string(value);
       break;
-    case PROP_INDEX:
-      self->index = g_value_get_int(value);
-      break;
+    case PROP_INDEX: self->index = g_value_get_int(value); break;
     case PROP_INDEX_LOCATION:
       g_free(self->index_location);
       self->index_location = g_value_dup_string(value);
       break;
-    case PROP_MAX_FILES:
-      self->max_files = g_value_get_uint64(value);
-      break;
-    case PROP_MAX_BYTES:
-      self->max_bytes = g_value_get_uint64(value);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
+    case PROP_MAX_FILES: self->max_files = g_value_get_uint64(value); break;
+    case PROP_MAX_BYTES: self->max_bytes = g_value_get_uint64(value); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -204,24 +196,12 @@ static void gst_neuflow_sink_get_property(GObject *object, guint prop_id, GValue
   GstNeuflowSink *self = GST_NEUFLOW_SINK(object);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
-    case PROP_LOCATION:
-      g_value_set_string(value, self->location);
-      break;
-    case PROP_INDEX:
-      g_value_set_int(value, self->index);
-      break;
-    case PROP_INDEX_LOCATION:
-      g_value_set_string(value, self->index_location);
-      break;
-    case PROP_MAX_FILES:
-      g_value_set_uint64(value, self->max_files);
-      break;
-    case PROP_MAX_BYTES:
-      g_value_set_uint64(value, self->max_bytes);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
+    case PROP_LOCATION: g_value_set_string(value, self->location); break;
+    case PROP_INDEX: g_value_set_int(value, self->index); break;
+    case PROP_INDEX_LOCATION: g_value_set_string(value, self->index_location); break;
+    case PROP_MAX_FILES: g_value_set_uint64(value, self->max_files); break;
+    case PROP_MAX_BYTES: g_value_set_uint64(value, self->max_bytes); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -591,18 +571,10 @@ static void gst_neuflow_sink_init(GstNeuflowSink *self) {
   self->location = g_strdup(DEFAULT_PROP_LOCATION);
   self->index_location = DEFAULT_PROP_INDEX_LOCATION;
   self->index = DEFAULT_PROP_INDEX;
-  self->pattern = nullptr;
-  self->index_path = nullptr;
-  self->index_dir = nullptr;
-  self->index_file = nullptr;
   self->max_files = DEFAULT_PROP_MAX_FILES;
   self->max_bytes = DEFAULT_PROP_MAX_BYTES;
-  self->written = nullptr;
-  self->index_rows = 0;
-  self->index_rows_known = FALSE;
-  self->index_foreign_rows = 0;
-  self->index_compact_floor = 0;
-  self->files_removed = 0;
+  // The run's state as after a run: GObject zeroes a new instance, so there is nothing to free.
+  gst_neuflow_sink_clear_run_state(self);
 }
 
 GST_ELEMENT_REGISTER_DEFINE(neuflowsink, "neuflowsink", GST_RANK_NONE, gst_neuflow_sink_get_type());

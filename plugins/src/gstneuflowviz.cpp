@@ -83,13 +83,13 @@ enum {
   PROP_ARROW_SCALE,
 };
 
-#define DEFAULT_MAX_FLOW 20.0
-#define DEFAULT_MODE GST_NEUFLOW_VIZ_MODE_OVERLAY /* what a live view over the video wants */
-#define DEFAULT_ALPHA 0.6
-#define DEFAULT_ARROWS FALSE
-#define DEFAULT_ARROW_SPACING 24u
-#define DEFAULT_ARROW_COLOR 0xff000000u /* opaque black, 0xAARRGGBB */
-#define DEFAULT_ARROW_SCALE 0.0         /* auto: a vector of max-flow pixels is arrow-spacing long */
+#define DEFAULT_PROP_MAX_FLOW 20.0
+#define DEFAULT_PROP_MODE GST_NEUFLOW_VIZ_MODE_OVERLAY /* what a live view over the video wants */
+#define DEFAULT_PROP_ALPHA 0.6
+#define DEFAULT_PROP_ARROWS FALSE
+#define DEFAULT_PROP_ARROW_SPACING 24u
+#define DEFAULT_PROP_ARROW_COLOR 0xff000000u /* opaque black, 0xAARRGGBB */
+#define DEFAULT_PROP_ARROW_SCALE 0.0         /* auto: a vector of max-flow pixels is arrow-spacing long */
 #define MAX_ARROW_SCALE 1000.0
 
 #define MIN_ARROW_SPACING 4u
@@ -99,13 +99,13 @@ enum {
 namespace {
 
 struct VizSettings {
-  gdouble max_flow = DEFAULT_MAX_FLOW;
-  GstNeuflowVizMode mode = DEFAULT_MODE;
-  gdouble alpha = DEFAULT_ALPHA;
-  gboolean arrows = DEFAULT_ARROWS;
-  guint arrow_spacing = DEFAULT_ARROW_SPACING;
-  guint arrow_color = DEFAULT_ARROW_COLOR;
-  gdouble arrow_scale = DEFAULT_ARROW_SCALE;
+  gdouble max_flow = DEFAULT_PROP_MAX_FLOW;
+  GstNeuflowVizMode mode = DEFAULT_PROP_MODE;
+  gdouble alpha = DEFAULT_PROP_ALPHA;
+  gboolean arrows = DEFAULT_PROP_ARROWS;
+  guint arrow_spacing = DEFAULT_PROP_ARROW_SPACING;
+  guint arrow_color = DEFAULT_PROP_ARROW_COLOR;
+  gdouble arrow_scale = DEFAULT_PROP_ARROW_SCALE;
 };
 
 struct PixelLayout;
@@ -329,30 +329,14 @@ static void gst_neuflow_viz_set_property(GObject *object, guint prop_id, const G
   GstNeuflowViz *self = GST_NEUFLOW_VIZ(object);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
-    case PROP_MAX_FLOW:
-      self->settings.max_flow = g_value_get_double(value);
-      break;
-    case PROP_MODE:
-      self->settings.mode = static_cast<GstNeuflowVizMode>(g_value_get_enum(value));
-      break;
-    case PROP_ALPHA:
-      self->settings.alpha = g_value_get_double(value);
-      break;
-    case PROP_ARROWS:
-      self->settings.arrows = g_value_get_boolean(value);
-      break;
-    case PROP_ARROW_SPACING:
-      self->settings.arrow_spacing = g_value_get_uint(value);
-      break;
-    case PROP_ARROW_COLOR:
-      self->settings.arrow_color = g_value_get_uint(value);
-      break;
-    case PROP_ARROW_SCALE:
-      self->settings.arrow_scale = g_value_get_double(value);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
+    case PROP_MAX_FLOW: self->settings.max_flow = g_value_get_double(value); break;
+    case PROP_MODE: self->settings.mode = static_cast<GstNeuflowVizMode>(g_value_get_enum(value)); break;
+    case PROP_ALPHA: self->settings.alpha = g_value_get_double(value); break;
+    case PROP_ARROWS: self->settings.arrows = g_value_get_boolean(value); break;
+    case PROP_ARROW_SPACING: self->settings.arrow_spacing = g_value_get_uint(value); break;
+    case PROP_ARROW_COLOR: self->settings.arrow_color = g_value_get_uint(value); break;
+    case PROP_ARROW_SCALE: self->settings.arrow_scale = g_value_get_double(value); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -361,30 +345,14 @@ static void gst_neuflow_viz_get_property(GObject *object, guint prop_id, GValue 
   GstNeuflowViz *self = GST_NEUFLOW_VIZ(object);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
-    case PROP_MAX_FLOW:
-      g_value_set_double(value, self->settings.max_flow);
-      break;
-    case PROP_MODE:
-      g_value_set_enum(value, self->settings.mode);
-      break;
-    case PROP_ALPHA:
-      g_value_set_double(value, self->settings.alpha);
-      break;
-    case PROP_ARROWS:
-      g_value_set_boolean(value, self->settings.arrows);
-      break;
-    case PROP_ARROW_SPACING:
-      g_value_set_uint(value, self->settings.arrow_spacing);
-      break;
-    case PROP_ARROW_COLOR:
-      g_value_set_uint(value, self->settings.arrow_color);
-      break;
-    case PROP_ARROW_SCALE:
-      g_value_set_double(value, self->settings.arrow_scale);
-      break;
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
+    case PROP_MAX_FLOW: g_value_set_double(value, self->settings.max_flow); break;
+    case PROP_MODE: g_value_set_enum(value, self->settings.mode); break;
+    case PROP_ALPHA: g_value_set_double(value, self->settings.alpha); break;
+    case PROP_ARROWS: g_value_set_boolean(value, self->settings.arrows); break;
+    case PROP_ARROW_SPACING: g_value_set_uint(value, self->settings.arrow_spacing); break;
+    case PROP_ARROW_COLOR: g_value_set_uint(value, self->settings.arrow_color); break;
+    case PROP_ARROW_SCALE: g_value_set_double(value, self->settings.arrow_scale); break;
+    default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec); break;
   }
   GST_OBJECT_UNLOCK(self);
 }
@@ -529,39 +497,39 @@ static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
                           "vectors are drawn saturated and dimmed. A fixed value keeps colours comparable from "
                           "frame to frame. 0 normalizes every frame by its own largest vector, which makes "
                           "colours flicker as the motion changes",
-                          0.0, MAX_MAX_FLOW, DEFAULT_MAX_FLOW, rw));
+                          0.0, MAX_MAX_FLOW, DEFAULT_PROP_MAX_FLOW, rw));
   g_object_class_install_property(
       gobject_class, PROP_MODE,
       g_param_spec_enum("mode", "Mode", "Whether the flow image replaces the video or is blended over it",
-                        GST_TYPE_NEUFLOW_VIZ_MODE, DEFAULT_MODE, rw));
+                        GST_TYPE_NEUFLOW_VIZ_MODE, DEFAULT_PROP_MODE, rw));
   g_object_class_install_property(
       gobject_class, PROP_ALPHA,
       g_param_spec_double("alpha", "Alpha",
                           "Opacity of the flow colours in overlay mode (0 = video only, 1 = flow only); "
                           "ignored in flow mode",
-                          0.0, 1.0, DEFAULT_ALPHA, rw));
+                          0.0, 1.0, DEFAULT_PROP_ALPHA, rw));
   g_object_class_install_property(
       gobject_class, PROP_ARROWS,
       g_param_spec_boolean("arrows", "Arrows",
                            "Draw a grid of anti-aliased arrows, one per arrow-spacing pixels, each showing the "
                            "displacement at its starting point, scaled by arrow-scale",
-                           DEFAULT_ARROWS, rw));
+                           DEFAULT_PROP_ARROWS, rw));
   g_object_class_install_property(
       gobject_class, PROP_ARROW_SPACING,
       g_param_spec_uint("arrow-spacing", "Arrow spacing", "Distance in frame pixels between neighbouring arrows",
-                        MIN_ARROW_SPACING, MAX_ARROW_SPACING, DEFAULT_ARROW_SPACING, rw));
+                        MIN_ARROW_SPACING, MAX_ARROW_SPACING, DEFAULT_PROP_ARROW_SPACING, rw));
   g_object_class_install_property(
       gobject_class, PROP_ARROW_COLOR,
       g_param_spec_uint("arrow-color", "Arrow colour",
                         "Colour of the arrows as 0xAARRGGBB (AA = opacity; default opaque black)", 0, G_MAXUINT32,
-                        DEFAULT_ARROW_COLOR, rw));
+                        DEFAULT_PROP_ARROW_COLOR, rw));
   g_object_class_install_property(
       gobject_class, PROP_ARROW_SCALE,
       g_param_spec_double("arrow-scale", "Arrow scale",
                           "Arrow length per pixel of displacement (1: true length). 0: automatic, a vector of "
                           "max-flow pixels is drawn arrow-spacing long and longer ones no longer, so arrows stay "
                           "within their cell",
-                          0.0, MAX_ARROW_SCALE, DEFAULT_ARROW_SCALE, rw));
+                          0.0, MAX_ARROW_SCALE, DEFAULT_PROP_ARROW_SCALE, rw));
 
   gst_element_class_set_static_metadata(element_class, "NeuFlow optical flow visualization",
                                         "Filter/Effect/Video/Analyzer",

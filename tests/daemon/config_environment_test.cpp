@@ -88,7 +88,7 @@ flow = { model = "models/m.pth" }
 sink = [ { type = "video", udp = "127.0.0.1:5000" } ]
 )");
   const Config c = parse_config(text, folder / "neuflowd.toml", ConfigChecks::all);
-  EXPECT_EQ(c.streams[0].flow.model, folder / "models/m.pth");
+  EXPECT_EQ(c.streams[0].flow.stage.model, folder / "models/m.pth");
   // Checking creates nothing.
   EXPECT_FALSE(fs::exists(folder / "out"));
 }

@@ -22,6 +22,25 @@ using test::issues_of;
 using test::kConfigFile;
 namespace fs = std::filesystem;
 
+// A [stream.flow] table as read: the given keys, every other one at its default.
+FlowConfig flow_config(const fs::path& model, model::Iterations iterations = {}, int model_width = 0,
+                       int model_height = 0, int threads = 0, model::Behaviour behaviour = model::Behaviour::automatic,
+                       model::ChannelOrder order = model::ChannelOrder::rgb,
+                       model::Backend backend = model::Backend::automatic, int device = -1) {
+  FlowConfig f;
+  f.stage.model = model;
+  f.stage.behaviour = behaviour;
+  model::SessionOptions& s = f.stage.session;
+  s.iterations = iterations;
+  s.model_width = model_width;
+  s.model_height = model_height;
+  s.threads = threads;
+  s.network_order = order;
+  s.backend = backend;
+  s.device = device;
+  return f;
+}
+
 Config parse(const std::string& text, const fs::path& file = kConfigFile) {
   return parse_config(text, file, ConfigChecks::file_only);
 }
@@ -132,8 +151,8 @@ sink = [ { type = "display" } ]
   EXPECT_EQ(std::get<V4l2Source>(front.source.settings),
             (V4l2Source{"/dev/video2", VideoMode{1280, 720, 30000, 1001}, true}));
   EXPECT_EQ(front.source.where.line, 18);
-  EXPECT_EQ(front.flow,
-            (FlowConfig{"/var/lib/neuflow/neuflow_mixed.pth", 2, 6, 640, 352, 3, "live", "bgr", "cpu", 0, "fp32", {}}));
+  EXPECT_EQ(front.flow, flow_config("/var/lib/neuflow/neuflow_mixed.pth", {2, 6}, 640, 352, 3, model::Behaviour::live,
+                                    model::ChannelOrder::bgr, model::Backend::cpu, 0));
   EXPECT_EQ(front.flow.where.line, 25);
   ASSERT_EQ(front.sinks.size(), 4u);
   EXPECT_EQ(front.sinks[0].name, "front-ring");
@@ -154,7 +173,7 @@ sink = [ { type = "display" } ]
   const StreamConfig& cam = c.streams[1];
   EXPECT_EQ(std::get<LibcameraSource>(cam.source.settings),
             (LibcameraSource{"/base/imx219@10", VideoMode{640, 480, 15, 1}}));
-  EXPECT_EQ(cam.flow, (FlowConfig{"/models/m.pth", 1, 8, 0, 0, 0, "auto", "rgb", "auto", -1, "fp32", {}}));
+  EXPECT_EQ(cam.flow, flow_config("/models/m.pth"));
   ASSERT_EQ(cam.sinks.size(), 2u);
   EXPECT_EQ(cam.sinks[0].name, "rec");
   VideoSink file;
@@ -168,7 +187,7 @@ sink = [ { type = "display" } ]
   EXPECT_EQ(std::get<VideoSink>(cam.sinks[1].settings), udp);
 
   EXPECT_EQ(std::get<UriSource>(c.streams[2].source.settings).uri, "rtsp://camera.local:554/stream1");
-  EXPECT_EQ(c.streams[2].flow.behaviour, "every-pair");
+  EXPECT_EQ(c.streams[2].flow.stage.behaviour, model::Behaviour::every_pair);
   EXPECT_EQ(std::get<FilesSink>(c.streams[2].sinks[0].settings), (FilesSink{"/out/clip", "flo", 0, 0}));
 
   EXPECT_EQ(std::get<TestSource>(c.streams[3].source.settings),
@@ -182,7 +201,7 @@ TEST(Config, OmittedKeysTakeTheirDefaults) {
   EXPECT_FALSE(c.rtsp);
   ASSERT_EQ(c.streams.size(), 1u);
   EXPECT_EQ(std::get<TestSource>(c.streams[0].source.settings), TestSource{});
-  EXPECT_EQ(c.streams[0].flow, (FlowConfig{"/m.pth", 1, 8, 0, 0, 0, "auto", "rgb", "auto", -1, "fp32", {}}));
+  EXPECT_EQ(c.streams[0].flow, flow_config("/m.pth"));
   EXPECT_EQ(c.streams[0].sinks[0].name, "display-0");
   EXPECT_EQ(std::get<DisplaySink>(c.streams[0].sinks[0].settings), DisplaySink{});
 
@@ -221,7 +240,7 @@ flow = { model = "../models/neuflow_mixed.pth" }
 )",
                          "/srv/neuflow/conf/main.toml");
   const StreamConfig& s = c.streams[0];
-  EXPECT_EQ(s.flow.model, fs::path("/srv/neuflow/models/neuflow_mixed.pth"));
+  EXPECT_EQ(s.flow.stage.model, fs::path("/srv/neuflow/models/neuflow_mixed.pth"));
   // A path becomes a file:// URI, escaped as URIs must be.
   EXPECT_EQ(std::get<UriSource>(s.source.settings).uri, "file:///srv/neuflow/conf/videos/in%20put.mp4");
   EXPECT_EQ(std::get<FilesSink>(s.sinks[0].settings).directory, fs::path("/srv/neuflow/conf/out/flow"));
@@ -238,7 +257,7 @@ flow = { model = "m.pth" }
 sink = [ { type = "display" } ]
 )",
                              "conf/x.toml");
-  EXPECT_EQ(model.streams[0].flow.model, fs::current_path() / "conf/m.pth");
+  EXPECT_EQ(model.streams[0].flow.stage.model, fs::current_path() / "conf/m.pth");
 }
 
 TEST(Config, FramerateIsAnIntegerOrAFraction) {
@@ -843,7 +862,7 @@ TEST(ConfigExamples, QuickStartDemoWritesIntoTheRepository) {
   ASSERT_EQ(c.streams.size(), 1u);
   const StreamConfig& s = c.streams[0];
   const fs::path repository = fs::weakly_canonical(dir / "..");
-  EXPECT_EQ(s.flow.model, repository / "models/neuflow_mixed.pth");
+  EXPECT_EQ(s.flow.stage.model, repository / "models/neuflow_mixed.pth");
   const auto& source = std::get<TestSource>(s.source.settings);
   EXPECT_GT(source.frames, 0);
   EXPECT_LE(source.mode.width * source.mode.height, 640 * 480);

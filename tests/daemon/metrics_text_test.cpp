@@ -184,17 +184,10 @@ bool unescape(const std::string& escaped, std::string& out) {
     }
     if (++i == escaped.size()) return false;
     switch (escaped[i]) {
-      case '\\':
-        out += '\\';
-        break;
-      case '"':
-        out += '"';
-        break;
-      case 'n':
-        out += '\n';
-        break;
-      default:
-        return false;
+      case '\\': out += '\\'; break;
+      case '"': out += '"'; break;
+      case 'n': out += '\n'; break;
+      default: return false;
     }
   }
   return true;

@@ -24,15 +24,9 @@ TEST(Architecture, TableHasTheCheckpointsParameterCount) {
     EXPECT_TRUE(names.insert(spec.name).second) << "duplicate " << spec.name;
     EXPECT_EQ(model::classify_key(spec.name), spec.kind) << spec.name;
     switch (spec.kind) {
-      case ParameterKind::kParameter:
-        parameters += spec.numel();
-        break;
-      case ParameterKind::kRunningStat:
-        running += spec.numel();
-        break;
-      case ParameterKind::kBatchCounter:
-        counters += spec.numel();
-        break;
+      case ParameterKind::kParameter: parameters += spec.numel(); break;
+      case ParameterKind::kRunningStat: running += spec.numel(); break;
+      case ParameterKind::kBatchCounter: counters += spec.numel(); break;
     }
   }
   EXPECT_EQ(parameters, model::kNeuflowV2ParameterCount);

@@ -126,17 +126,10 @@ TEST_P(ConvOpTest, MatchesNaiveConvolution) {
         float e = naive_conv(w, in, p.stride, p.pad, y, x, c);
         if (p.accumulate) e += addend_t.pixel(y, x)[c];
         switch (p.act) {
-          case Activation::none:
-            break;
-          case Activation::relu:
-            e = std::max(e, 0.f);
-            break;
-          case Activation::leaky_relu:
-            e = e < 0 ? 0.1f * e : e;
-            break;
-          case Activation::gelu:
-            e = 0.5f * e * (1.f + std::erf(e / std::sqrt(2.f)));
-            break;
+          case Activation::none: break;
+          case Activation::relu: e = std::max(e, 0.f); break;
+          case Activation::leaky_relu: e = e < 0 ? 0.1f * e : e; break;
+          case Activation::gelu: e = 0.5f * e * (1.f + std::erf(e / std::sqrt(2.f))); break;
         }
         ASSERT_NEAR(out.pixel(y, x)[c], e, 1e-4f * (1.f + std::fabs(e)))
             << "in_c " << p.in_c << " out_c " << p.out_c << " k " << p.k << " stride " << p.stride << " pad " << p.pad

@@ -97,7 +97,7 @@ TEST(GraphPlan, FlowStageCarriesTheSessionSettings) {
                   .network_order = model::ChannelOrder::bgr,
                   .backend = model::Backend::vulkan,
                   .device = 1};
-  flow.behaviour = "live";
+  flow.behaviour = model::Behaviour::live;
   const ElementChain chain = plan_flow(flow);
   ASSERT_EQ(chain.size(), 2u);
   EXPECT_EQ(launch_text({chain[1]}),

@@ -160,15 +160,9 @@ TEST_P(NeuflowSinkFormats, FormatFollowsTheExtension) {
   char magic[8] = {};
   in.read(magic, sizeof magic);
   switch (*format) {
-    case flow::FlowFormat::flo:
-      EXPECT_EQ(std::string(magic, 4), "PIEH");
-      break;
-    case flow::FlowFormat::npy:
-      EXPECT_EQ(std::string(magic + 1, 5), "NUMPY");
-      break;
-    case flow::FlowFormat::kitti_png:
-      EXPECT_EQ(std::string(magic + 1, 3), "PNG");
-      break;
+    case flow::FlowFormat::flo: EXPECT_EQ(std::string(magic, 4), "PIEH"); break;
+    case flow::FlowFormat::npy: EXPECT_EQ(std::string(magic + 1, 5), "NUMPY"); break;
+    case flow::FlowFormat::kitti_png: EXPECT_EQ(std::string(magic + 1, 3), "PNG"); break;
   }
 }
 

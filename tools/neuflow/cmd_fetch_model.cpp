@@ -33,14 +33,10 @@ struct FetchModelArgs {
 
 int fetch_exit_code(const FetchError& e) {
   switch (e.kind()) {
-    case FetchError::Kind::kUnavailable:
-      return kExitUnavailable;
-    case FetchError::Kind::kIntegrity:
-      return kExitDataError;
-    case FetchError::Kind::kLocalIo:
-      return kExitCantCreate;
-    case FetchError::Kind::kInterrupted:
-      return kExitInterrupted;
+    case FetchError::Kind::kUnavailable: return kExitUnavailable;
+    case FetchError::Kind::kIntegrity: return kExitDataError;
+    case FetchError::Kind::kLocalIo: return kExitCantCreate;
+    case FetchError::Kind::kInterrupted: return kExitInterrupted;
   }
   return kExitFailure;
 }

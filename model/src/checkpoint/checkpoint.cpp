@@ -65,18 +65,12 @@ U load(const unsigned char* p, bool big_endian) {
 
 float element(const unsigned char* p, StorageDtype dtype, bool big_endian) {
   switch (dtype) {
-    case StorageDtype::kFloat32:
-      return std::bit_cast<float>(load<uint32_t>(p, big_endian));
-    case StorageDtype::kFloat16:
-      return half_to_float(load<uint16_t>(p, big_endian));
-    case StorageDtype::kBFloat16:
-      return std::bit_cast<float>(uint32_t{load<uint16_t>(p, big_endian)} << 16);
-    case StorageDtype::kFloat64:
-      return static_cast<float>(std::bit_cast<double>(load<uint64_t>(p, big_endian)));
-    case StorageDtype::kInt64:
-      return static_cast<float>(static_cast<int64_t>(load<uint64_t>(p, big_endian)));
-    case StorageDtype::kInt32:
-      return static_cast<float>(static_cast<int32_t>(load<uint32_t>(p, big_endian)));
+    case StorageDtype::kFloat32: return std::bit_cast<float>(load<uint32_t>(p, big_endian));
+    case StorageDtype::kFloat16: return half_to_float(load<uint16_t>(p, big_endian));
+    case StorageDtype::kBFloat16: return std::bit_cast<float>(uint32_t{load<uint16_t>(p, big_endian)} << 16);
+    case StorageDtype::kFloat64: return static_cast<float>(std::bit_cast<double>(load<uint64_t>(p, big_endian)));
+    case StorageDtype::kInt64: return static_cast<float>(static_cast<int64_t>(load<uint64_t>(p, big_endian)));
+    case StorageDtype::kInt32: return static_cast<float>(static_cast<int32_t>(load<uint32_t>(p, big_endian)));
   }
   return 0.f;
 }

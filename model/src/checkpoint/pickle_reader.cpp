@@ -9,18 +9,12 @@ namespace neuflow::model::detail {
 
 const char* dtype_name(StorageDtype dtype) {
   switch (dtype) {
-    case StorageDtype::kFloat32:
-      return "float32";
-    case StorageDtype::kFloat16:
-      return "float16";
-    case StorageDtype::kBFloat16:
-      return "bfloat16";
-    case StorageDtype::kFloat64:
-      return "float64";
-    case StorageDtype::kInt64:
-      return "int64";
-    case StorageDtype::kInt32:
-      return "int32";
+    case StorageDtype::kFloat32: return "float32";
+    case StorageDtype::kFloat16: return "float16";
+    case StorageDtype::kBFloat16: return "bfloat16";
+    case StorageDtype::kFloat64: return "float64";
+    case StorageDtype::kInt64: return "int64";
+    case StorageDtype::kInt32: return "int32";
   }
   return "?";
 }
@@ -28,14 +22,11 @@ const char* dtype_name(StorageDtype dtype) {
 std::size_t dtype_size(StorageDtype dtype) {
   switch (dtype) {
     case StorageDtype::kFloat16:
-    case StorageDtype::kBFloat16:
-      return 2;
+    case StorageDtype::kBFloat16: return 2;
     case StorageDtype::kFloat32:
-    case StorageDtype::kInt32:
-      return 4;
+    case StorageDtype::kInt32: return 4;
     case StorageDtype::kFloat64:
-    case StorageDtype::kInt64:
-      return 8;
+    case StorageDtype::kInt64: return 8;
   }
   return 0;
 }
@@ -111,82 +102,40 @@ class Unpickler {
         case 0x95:  // FRAME (protocol 4+): a length hint only
           take(8);
           break;
-        case '}':
-          push(make(DictValue{}));
-          break;  // EMPTY_DICT
-        case ']':
-          push(make(ListValue{}));
-          break;  // EMPTY_LIST
-        case ')':
-          push(make(TupleValue{}));
-          break;  // EMPTY_TUPLE
-        case 'N':
-          push(make(NoneValue{}));
-          break;  // NONE
-        case 0x88:
-          push(make(true));
-          break;  // NEWTRUE
-        case 0x89:
-          push(make(false));
-          break;   // NEWFALSE
-        case '(':  // MARK
+        case '}': push(make(DictValue{})); break;   // EMPTY_DICT
+        case ']': push(make(ListValue{})); break;   // EMPTY_LIST
+        case ')': push(make(TupleValue{})); break;  // EMPTY_TUPLE
+        case 'N': push(make(NoneValue{})); break;   // NONE
+        case 0x88: push(make(true)); break;         // NEWTRUE
+        case 0x89: push(make(false)); break;        // NEWFALSE
+        case '(':                                   // MARK
           if (marks_.size() >= limits_.max_marks) fail(Kind::kFormat, "MARKs nested too deeply");
           marks_.push_back(stack_.size());
           break;
-        case 'X':
-          push(make(string(u32())));
-          break;  // BINUNICODE
-        case 0x8c:
-          push(make(string(u8())));
-          break;  // SHORT_BINUNICODE
-        case 0x8d:
-          push(make(string(u64())));
-          break;  // BINUNICODE8
-        case 'K':
-          push(make(int64_t{u8()}));
-          break;  // BININT1
-        case 'M':
-          push(make(int64_t{u16()}));
-          break;   // BININT2
-        case 'J':  // BININT
+        case 'X': push(make(string(u32()))); break;   // BINUNICODE
+        case 0x8c: push(make(string(u8()))); break;   // SHORT_BINUNICODE
+        case 0x8d: push(make(string(u64()))); break;  // BINUNICODE8
+        case 'K': push(make(int64_t{u8()})); break;   // BININT1
+        case 'M': push(make(int64_t{u16()})); break;  // BININT2
+        case 'J':                                     // BININT
           push(make(int64_t{static_cast<int32_t>(u32())}));
           break;
-        case 0x8a:
-          push(make(long1()));
-          break;  // LONG1
-        case 'G':
-          push(make(binfloat()));
-          break;  // BINFLOAT
-        case 'q':
-          memo_put(u8());
-          break;  // BINPUT
-        case 'r':
-          memo_put(u32());
-          break;  // LONG_BINPUT
-        case 0x94:
-          memo_put(memo_count_);
-          break;  // MEMOIZE: index len(memo)
-        case 'h':
-          push(memo_get(u8()));
-          break;  // BINGET
-        case 'j':
-          push(memo_get(u32()));
-          break;     // LONG_BINGET
-        case 't': {  // TUPLE
+        case 0x8a: push(make(long1())); break;    // LONG1
+        case 'G': push(make(binfloat())); break;  // BINFLOAT
+        case 'q': memo_put(u8()); break;          // BINPUT
+        case 'r': memo_put(u32()); break;         // LONG_BINPUT
+        case 0x94: memo_put(memo_count_); break;  // MEMOIZE: index len(memo)
+        case 'h': push(memo_get(u8())); break;    // BINGET
+        case 'j': push(memo_get(u32())); break;   // LONG_BINGET
+        case 't': {                               // TUPLE
           TupleValue tuple{pop_mark()};
           push(make(std::move(tuple)));
           break;
         }
-        case 0x85:
-          tuple_n(1);
-          break;  // TUPLE1
-        case 0x86:
-          tuple_n(2);
-          break;  // TUPLE2
-        case 0x87:
-          tuple_n(3);
-          break;     // TUPLE3
-        case 's': {  // SETITEM
+        case 0x85: tuple_n(1); break;  // TUPLE1
+        case 0x86: tuple_n(2); break;  // TUPLE2
+        case 0x87: tuple_n(3); break;  // TUPLE3
+        case 's': {                    // SETITEM
           const PickleValue* value = pop();
           const PickleValue* key = pop();
           dict_at_top().entries.emplace_back(key, value);
@@ -233,10 +182,8 @@ class Unpickler {
           push(reduce(*callable, *args));
           break;
         }
-        case 'Q':
-          push(persistent_id(*pop()));
-          break;     // BINPERSID
-        case 'b': {  // BUILD
+        case 'Q': push(persistent_id(*pop())); break;  // BINPERSID
+        case 'b': {                                    // BUILD
           const PickleValue* state = pop();
           build(top(), *state);
           break;
@@ -477,8 +424,7 @@ class Unpickler {
           fail(Kind::kFormat, "_rebuild_parameter needs (tensor, requires_grad, hooks)");
         }
         return a[0];
-      case Global::kStorageType:
-        break;
+      case Global::kStorageType: break;
     }
     fail(Kind::kUnsupported, "calling " + fn->name + " (only tensors are rebuilt)");
   }

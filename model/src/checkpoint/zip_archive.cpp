@@ -53,10 +53,8 @@ ZipArchive::ZipArchive(const std::filesystem::path& path) {
       case ZIP_ER_NOENT:
       case ZIP_ER_OPEN:
       case ZIP_ER_READ:
-      case ZIP_ER_SEEK:
-        throw CheckpointError(Kind::kIo, "cannot read the file: " + libzip_message(code));
-      default:
-        throw CheckpointError(Kind::kFormat, "cannot open the zip archive: " + libzip_message(code));
+      case ZIP_ER_SEEK: throw CheckpointError(Kind::kIo, "cannot read the file: " + libzip_message(code));
+      default: throw CheckpointError(Kind::kFormat, "cannot open the zip archive: " + libzip_message(code));
     }
   }
 

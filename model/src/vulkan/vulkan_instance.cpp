@@ -148,21 +148,11 @@ GpuDevice describe(VkPhysicalDevice device, int index) {
   d.index = index;
   d.name = props.deviceName;
   switch (props.deviceType) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
-      d.type = "discrete";
-      break;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
-      d.type = "integrated";
-      break;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
-      d.type = "virtual";
-      break;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU:
-      d.type = "cpu";
-      break;
-    default:
-      d.type = "other";
-      break;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: d.type = "discrete"; break;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: d.type = "integrated"; break;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: d.type = "virtual"; break;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: d.type = "cpu"; break;
+    default: d.type = "other"; break;
   }
   d.api_version = version_text(props.apiVersion);
   d.driver = "driver version " + std::to_string(props.driverVersion);

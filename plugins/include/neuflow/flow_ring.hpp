@@ -233,14 +233,10 @@ enum class ReadStatus {
 
 inline const char *to_string(ReadStatus s) {
   switch (s) {
-    case ReadStatus::ok:
-      return "ok";
-    case ReadStatus::not_published:
-      return "not published";
-    case ReadStatus::overwritten:
-      return "overwritten";
-    case ReadStatus::torn:
-      return "torn";
+    case ReadStatus::ok: return "ok";
+    case ReadStatus::not_published: return "not published";
+    case ReadStatus::overwritten: return "overwritten";
+    case ReadStatus::torn: return "torn";
   }
   return "?";
 }

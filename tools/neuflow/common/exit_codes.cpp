@@ -6,13 +6,10 @@ namespace neuflow::cli {
 
 int exit_code_for(const flow::FlowFileError& e) {
   switch (e.kind()) {
-    case flow::FlowFileError::Kind::not_found:
-      return kExitNoInput;
-    case flow::FlowFileError::Kind::write_failed:
-      return kExitCantCreate;
+    case flow::FlowFileError::Kind::not_found: return kExitNoInput;
+    case flow::FlowFileError::Kind::write_failed: return kExitCantCreate;
     case flow::FlowFileError::Kind::malformed:
-    case flow::FlowFileError::Kind::unsupported_format:
-      return kExitDataError;
+    case flow::FlowFileError::Kind::unsupported_format: return kExitDataError;
   }
   return kExitFailure;
 }

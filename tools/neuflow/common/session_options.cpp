@@ -4,55 +4,50 @@
 #include <stdexcept>
 
 #include "common/exit_codes.hpp"
+#include "neuflow/model/session_option_docs.hpp"
 
 namespace neuflow::cli {
+
+namespace {
+namespace docs = model::option_docs;
+// The option as the element's property and neuflowd's key name it, with the same help.
+std::string flag(const model::OptionDoc& doc) { return "--" + std::string(doc.name); }
+std::string help(const model::OptionDoc& doc) { return std::string(doc.help); }
+}  // namespace
 
 void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions model_size) {
   using L = model::SessionLimits;
   auto& o = args.options;
   if (model_size == ModelSizeOptions::offered) {
-    command
-        .add_option("--model-width", o.model_width,
-                    "Width the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
+    command.add_option(flag(docs::model_width), o.model_width, help(docs::model_width))
         ->capture_default_str()
         ->check(CLI::Range(0, L::max_side));
-    command
-        .add_option("--model-height", o.model_height,
-                    "Height the network runs at (multiple of 16); 0: the frames' own size, edge-padded")
+    command.add_option(flag(docs::model_height), o.model_height, help(docs::model_height))
         ->capture_default_str()
         ->check(CLI::Range(0, L::max_side));
     // Hidden (an empty group): the spelling of earlier releases.
     command.add_option("--size", args.size_alias, "Same as --model-width W --model-height H")->group("");
   }
-  command.add_option("--iters-s16", o.iterations.s16, "Refinement iterations at 1/16 resolution")
+  command.add_option(flag(docs::iters_s16), o.iterations.s16, help(docs::iters_s16))
       ->capture_default_str()
       ->check(CLI::Range(0, L::max_iterations_s16));
-  command.add_option("--iters-s8", o.iterations.s8, "Refinement iterations at 1/8 resolution")
+  command.add_option(flag(docs::iters_s8), o.iterations.s8, help(docs::iters_s8))
       ->capture_default_str()
       ->check(CLI::Range(0, L::max_iterations_s8));
-  command
-      .add_option("--channel-order", args.channel_order,
-                  "Colour order fed to the network: rgb (what the published weights were trained with) or bgr (as "
-                  "the reference demo scripts feed it)")
+  command.add_option(flag(docs::channel_order), args.channel_order, help(docs::channel_order))
       ->check(CLI::IsMember({"rgb", "bgr"}))
       ->capture_default_str();
   command.add_flag("--bgr", args.bgr_alias, "Same as --channel-order bgr")->group("");
-  command.add_option("--threads", o.threads, "CPU threads for inference (0: all cores)")
+  command.add_option(flag(docs::threads), o.threads, help(docs::threads))
       ->capture_default_str()
       ->check(CLI::Range(0, L::max_threads));
-  command
-      .add_option("--backend", args.backend,
-                  "Where the network runs: auto (the first discrete or integrated GPU through Vulkan, else the "
-                  "CPU), cpu, or vulkan (any Vulkan device, software ones included)")
+  command.add_option(flag(docs::backend), args.backend, help(docs::backend))
       ->check(CLI::IsMember({"auto", "cpu", "vulkan"}))
       ->capture_default_str();
-  command.add_option("--device", o.device, "Vulkan device index, as `neuflow devices` lists them (-1: the first GPU)")
+  command.add_option(flag(docs::device), o.device, help(docs::device))
       ->capture_default_str()
       ->check(CLI::Range(-1, L::max_device));
-  command
-      .add_option("--precision", args.precision,
-                  "What a Vulkan device stores tensors in: fp32 (exact), or fp16 (half the memory; devices with "
-                  "shaderFloat16, else fp32 with a warning). The CPU computes in fp32")
+  command.add_option(flag(docs::precision), args.precision, help(docs::precision))
       ->check(CLI::IsMember({"fp32", "fp16"}))
       ->capture_default_str();
 }

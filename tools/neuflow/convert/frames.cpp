@@ -133,20 +133,11 @@ pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems) 
   const std::size_t digits = stems.front().size();
   double unit = 0;  // seconds per tick
   switch (digits) {
-    case 10:
-      unit = 1;
-      break;
-    case 13:
-      unit = 1e-3;
-      break;
-    case 16:
-      unit = 1e-6;
-      break;
-    case 19:
-      unit = 1e-9;
-      break;
-    default:
-      return {};
+    case 10: unit = 1; break;
+    case 13: unit = 1e-3; break;
+    case 16: unit = 1e-6; break;
+    case 19: unit = 1e-9; break;
+    default: return {};
   }
   std::uint64_t previous = 0;
   std::uint64_t first = 0;
@@ -179,8 +170,7 @@ std::unique_ptr<FrameSource> open_frames(const InputSpec& input) {
       }
       return std::make_unique<ImageSequence>(name_images(images));
     }
-    case InputKind::video:
-      return std::make_unique<VideoFrames>(input.paths[0]);
+    case InputKind::video: return std::make_unique<VideoFrames>(input.paths[0]);
   }
   throw InputError(kExitFailure, input.label + ": unknown kind of input");
 }

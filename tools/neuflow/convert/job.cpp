@@ -29,12 +29,9 @@ constexpr pipeline::FrameRate kImageSequenceRate{10, 1};
 
 const char* extension_of(flow::FlowFormat format) {
   switch (format) {
-    case flow::FlowFormat::flo:
-      return ".flo";
-    case flow::FlowFormat::kitti_png:
-      return ".png";
-    case flow::FlowFormat::npy:
-      return ".npy";
+    case flow::FlowFormat::flo: return ".flo";
+    case flow::FlowFormat::kitti_png: return ".png";
+    case flow::FlowFormat::npy: return ".npy";
   }
   return ".flo";
 }

@@ -188,8 +188,7 @@ extern "C" int on_progress(void* user, curl_off_t dltotal, curl_off_t dlnow, cur
       throw FetchError(Kind::kUnavailable, url + ": more than " + std::to_string(kMaxRedirects) + " redirects");
     case CURLE_UNSUPPORTED_PROTOCOL:
       throw FetchError(Kind::kUnavailable, url + ": only http:// and https:// URLs are fetched (" + detail + ")");
-    case CURLE_URL_MALFORMAT:
-      throw FetchError(Kind::kUnavailable, url + ": not a valid URL (" + detail + ")");
+    case CURLE_URL_MALFORMAT: throw FetchError(Kind::kUnavailable, url + ": not a valid URL (" + detail + ")");
     case CURLE_PEER_FAILED_VERIFICATION:
     case CURLE_SSL_CONNECT_ERROR:
     case CURLE_SSL_CACERT_BADFILE:
@@ -197,8 +196,7 @@ extern "C" int on_progress(void* user, curl_off_t dltotal, curl_off_t dlnow, cur
                                                "); check the system clock and CA certificates (ca-certificates)");
     case CURLE_ABORTED_BY_CALLBACK:
       throw FetchError(Kind::kInterrupted, url + ": download interrupted, nothing was saved");
-    default:
-      throw FetchError(Kind::kUnavailable, url + ": " + detail);
+    default: throw FetchError(Kind::kUnavailable, url + ": " + detail);
   }
 }
 

@@ -33,6 +33,12 @@ enum class Precision { fp32, fp16 };
 // (tests/model/winograd_conv_test.cpp states the bounds).
 enum class CpuConvolution { automatic, direct, winograd, winograd4, winograd6 };
 
+// How a stream of frames keeps up (the element's `behaviour` property, neuflowd's `behaviour`
+// key): `live` holds real time (the newest frame wins, late ones are dropped), `every_pair`
+// computes every consecutive pair (upstream waits, nothing is dropped), `automatic` is live for
+// live sources and every-pair otherwise.
+enum class Behaviour { automatic, live, every_pair };
+
 struct Iterations {
   int s16 = 1;  // refinement iterations at 1/16
   int s8 = 8;   // refinement iterations at 1/8
@@ -105,18 +111,18 @@ constexpr std::string_view precision_name(Precision precision) {
 }
 std::optional<Precision> parse_precision(std::string_view name);  // "fp32", "fp16"
 
+constexpr std::string_view behaviour_name(Behaviour behaviour) {
+  return behaviour == Behaviour::live ? "live" : behaviour == Behaviour::every_pair ? "every-pair" : "auto";
+}
+std::optional<Behaviour> parse_behaviour(std::string_view name);  // "auto", "live", "every-pair"
+
 constexpr std::string_view cpu_convolution_name(CpuConvolution c) {
   switch (c) {
-    case CpuConvolution::direct:
-      return "direct";
-    case CpuConvolution::winograd:
-      return "winograd";
-    case CpuConvolution::winograd4:
-      return "winograd4";
-    case CpuConvolution::winograd6:
-      return "winograd6";
-    case CpuConvolution::automatic:
-      break;
+    case CpuConvolution::direct: return "direct";
+    case CpuConvolution::winograd: return "winograd";
+    case CpuConvolution::winograd4: return "winograd4";
+    case CpuConvolution::winograd6: return "winograd6";
+    case CpuConvolution::automatic: break;
   }
   return "auto";
 }

@@ -18,17 +18,10 @@ dnnl::primitive_attr make_attr(const ConvParams& p) {
   dnnl::post_ops ops;
   if (p.accumulate) ops.append_sum(1.f);
   switch (p.activation) {
-    case Activation::none:
-      break;
-    case Activation::leaky_relu:
-      ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.1f, 0.f);
-      break;
-    case Activation::relu:
-      ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.f, 0.f);
-      break;
-    case Activation::gelu:
-      ops.append_eltwise(1.f, dnnl::algorithm::eltwise_gelu_erf, 0.f, 0.f);
-      break;
+    case Activation::none: break;
+    case Activation::leaky_relu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.1f, 0.f); break;
+    case Activation::relu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_relu, 0.f, 0.f); break;
+    case Activation::gelu: ops.append_eltwise(1.f, dnnl::algorithm::eltwise_gelu_erf, 0.f, 0.f); break;
   }
   dnnl::primitive_attr attr;
   attr.set_post_ops(ops);

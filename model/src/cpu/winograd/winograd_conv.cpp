@@ -302,14 +302,11 @@ template <typename T>
 void WinogradConv::transform_outputs(const float* products, int first, int count, const float* addend,
                                      float* output) const {
   switch (activation_) {
-    case Activation::none:
-      return transform_outputs_as<T, Activation::none>(products, first, count, addend, output);
+    case Activation::none: return transform_outputs_as<T, Activation::none>(products, first, count, addend, output);
     case Activation::leaky_relu:
       return transform_outputs_as<T, Activation::leaky_relu>(products, first, count, addend, output);
-    case Activation::relu:
-      return transform_outputs_as<T, Activation::relu>(products, first, count, addend, output);
-    case Activation::gelu:
-      return transform_outputs_as<T, Activation::gelu>(products, first, count, addend, output);
+    case Activation::relu: return transform_outputs_as<T, Activation::relu>(products, first, count, addend, output);
+    case Activation::gelu: return transform_outputs_as<T, Activation::gelu>(products, first, count, addend, output);
   }
 }
 

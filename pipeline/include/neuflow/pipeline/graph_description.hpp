@@ -57,9 +57,9 @@ using SourceDescription = std::variant<V4l2Source, LibcameraSource, UriSource, T
 // ---- the flow stage ------------------------------------------------------------------------
 
 struct FlowStage {
-  std::filesystem::path model;     // a NeuFlow-V2 checkpoint (.pth)
-  model::SessionOptions session;   // iterations, model size, channel order; threads as given
-  std::string behaviour = "auto";  // auto | live | every-pair
+  std::filesystem::path model;    // a NeuFlow-V2 checkpoint (.pth)
+  model::SessionOptions session;  // iterations, model size, channel order; threads as given
+  model::Behaviour behaviour = model::Behaviour::automatic;
   bool operator==(const FlowStage&) const = default;
 };
 
