@@ -494,41 +494,32 @@ int main(int argc, char** argv) {
     using neuflow::model::Backend;
     using neuflow::model::CpuConvolution;
     const Variant direct{Backend::cpu, CpuConvolution::direct}, cpu{Backend::cpu, CpuConvolution::automatic};
+    // Whole frames: timed for at least 2 s each; stage breakdowns: three frames each.
+    const auto timed = [w = w, h = h](const std::string& name, auto run, const Variant& variant) {
+      benchmark::RegisterBenchmark(name.c_str(), run, w, h, variant)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+    };
+    const auto staged = [w = w, h = h](const std::string& name, auto run, const Variant& variant) {
+      benchmark::RegisterBenchmark(name.c_str(), run, w, h, variant)->Unit(benchmark::kMillisecond)->Iterations(3);
+    };
     for (const char* mode : {"pair", "stream"}) {
       const auto run = std::string(mode) == "pair" ? BM_Pair : BM_Stream;
-      benchmark::RegisterBenchmark(("direct_" + std::string(mode) + "/" + size).c_str(), run, w, h, direct)
-          ->Unit(benchmark::kMillisecond)
-          ->MinTime(2.0);
-      benchmark::RegisterBenchmark((std::string(mode) + "/" + size).c_str(), run, w, h, cpu)
-          ->Unit(benchmark::kMillisecond)
-          ->MinTime(2.0);
+      timed("direct_" + std::string(mode) + "/" + size, run, direct);
+      timed(std::string(mode) + "/" + size, run, cpu);
     }
     // Lavapipe (Vulkan on the CPU) runs these too, but its times say nothing of a GPU's.
-    for (const auto precision : g_config.vulkan ? g_config.precisions : std::vector<neuflow::model::Precision>{}) {
+    const auto gpu_precisions = g_config.vulkan ? g_config.precisions : std::vector<neuflow::model::Precision>{};
+    for (const auto precision : gpu_precisions) {
       const Variant vulkan{Backend::vulkan, CpuConvolution::automatic, precision};
       const std::string prefix = gpu_prefix(precision);
-      benchmark::RegisterBenchmark((prefix + "pair/" + size).c_str(), BM_Pair, w, h, vulkan)
-          ->Unit(benchmark::kMillisecond)
-          ->MinTime(2.0);
-      benchmark::RegisterBenchmark((prefix + "stream/" + size).c_str(), BM_Stream, w, h, vulkan)
-          ->Unit(benchmark::kMillisecond)
-          ->MinTime(2.0);
-      benchmark::RegisterBenchmark((prefix + "stream_pipelined/" + size).c_str(), BM_StreamPipelined, w, h, vulkan)
-          ->Unit(benchmark::kMillisecond)
-          ->MinTime(2.0);
+      timed(prefix + "pair/" + size, BM_Pair, vulkan);
+      timed(prefix + "stream/" + size, BM_Stream, vulkan);
+      timed(prefix + "stream_pipelined/" + size, BM_StreamPipelined, vulkan);
     }
-    benchmark::RegisterBenchmark(("direct_stream_stages/" + size).c_str(), BM_StreamStages, w, h, direct)
-        ->Unit(benchmark::kMillisecond)
-        ->Iterations(3);
-    benchmark::RegisterBenchmark(("stream_stages/" + size).c_str(), BM_StreamStages, w, h, cpu)
-        ->Unit(benchmark::kMillisecond)
-        ->Iterations(3);
-    for (const auto precision : g_config.vulkan ? g_config.precisions : std::vector<neuflow::model::Precision>{}) {
-      const Variant vulkan{Backend::vulkan, CpuConvolution::automatic, precision};
-      const std::string prefix = gpu_prefix(precision);
-      benchmark::RegisterBenchmark((prefix + "stream_stages/" + size).c_str(), BM_VulkanStreamStages, w, h, vulkan)
-          ->Unit(benchmark::kMillisecond)
-          ->Iterations(3);
+    staged("direct_stream_stages/" + size, BM_StreamStages, direct);
+    staged("stream_stages/" + size, BM_StreamStages, cpu);
+    for (const auto precision : gpu_precisions) {
+      staged(gpu_prefix(precision) + "stream_stages/" + size, BM_VulkanStreamStages,
+             Variant{Backend::vulkan, CpuConvolution::automatic, precision});
     }
   }
   benchmark::Initialize(&argc, argv);

@@ -9,9 +9,9 @@
 #include <string>
 #include <utility>
 
+#include "backend_registry.hpp"
 #include "frame_geometry.hpp"
 #include "inference_backend.hpp"
-#include "vulkan/vulkan_backend.hpp"
 
 namespace neuflow::model {
 
@@ -19,11 +19,9 @@ namespace neuflow::model {
 // current one's); compute() uses the two that do not hold the stream's previous frame.
 struct FlowSession::State {
   FrameGeometry geometry;
-  std::unique_ptr<InferenceBackend> backend;
-  std::shared_ptr<VulkanContext> vulkan;  // set while the session runs on a Vulkan device
-  std::string description = "cpu";
-  std::string fallback;
-  Tensor input;  // a frame converted here, for a backend that does not convert it itself
+  std::unique_ptr<BackendRegistry> backends;  // where the network runs, and its fallback
+  std::unique_ptr<InferenceBackend> backend;  // the plan for the current model size
+  Tensor input;                               // a frame converted here, for a backend that does not convert it itself
   int previous_slot = 0;
   bool has_previous = false;
   StageObserver observer;
@@ -59,22 +57,7 @@ FlowSession::FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions 
   if (!model_) throw std::invalid_argument("FlowSession needs a loaded model");
   if (auto problem = check_session_options(options_)) throw std::invalid_argument(*problem);
   cpu_convolution_from_environment();  // a bad NEUFLOW_CONV fails here, before any frame
-  auto& s = *state_;
-  if (options_.backend == Backend::vulkan) {
-    s.vulkan = open_vulkan(model_, options_.device, options_.precision, s.fallback);
-  } else if (options_.backend == Backend::automatic) {
-    if (const int gpu = find_gpu_for_auto(options_.device); gpu >= 0) {
-      try {
-        s.vulkan = open_vulkan(model_, gpu, options_.precision, s.fallback);
-      } catch (const BackendError& e) {
-        s.fallback = std::string("backend auto: ") + e.what() + "; running on the CPU instead";
-      }
-    } else if (options_.device >= 0) {
-      s.fallback = "backend auto: no Vulkan device " + std::to_string(options_.device) +
-                   " (`neuflow devices` lists them); running on the CPU instead";
-    }
-  }
-  if (s.vulkan) s.description = describe(*s.vulkan);
+  state_->backends = std::make_unique<BackendRegistry>(model_, options_);
 }
 
 FlowSession::~FlowSession() = default;
@@ -90,11 +73,11 @@ int FlowSession::max_in_flight() const {
   // (unless backend=auto leaves it for the CPU at the first frame).
   const auto& s = *state_;
   if (s.backend) return std::max(1, s.backend->stream_depth());
-  return s.vulkan ? kVulkanStreamDepth : 1;
+  return s.backends->stream_depth();
 }
 
-const std::string& FlowSession::backend_description() const { return state_->description; }
-const std::string& FlowSession::fallback_warning() const { return state_->fallback; }
+const std::string& FlowSession::backend_description() const { return state_->backends->description(); }
+const std::string& FlowSession::fallback_warning() const { return state_->backends->fallback(); }
 const std::vector<StageTime>& FlowSession::device_stage_times() const { return state_->stage_times; }
 
 namespace {
@@ -129,24 +112,13 @@ void finish_started(FlowSession::State& s) {
 // Makes the state ready for frames of this size: a new size ends the stream, and a new
 // model size replaces the plan (the old one's buffers are released first). With
 // backend=auto, a GPU that cannot hold this size leaves the session on the CPU.
-const FrameGeometry& prepare_plan(FlowSession::State& s, const FlowModel& model, const SessionOptions& options,
-                                  int width, int height) {
+const FrameGeometry& prepare_plan(FlowSession::State& s, const SessionOptions& options, int width, int height) {
   const FrameGeometry g = plan_geometry(width, height, options);
   if (s.backend && g == s.geometry) return s.geometry;
   finish_started(s);  // their passes use the plan about to be replaced
   if (!s.backend || s.backend->width() != g.model_width || s.backend->height() != g.model_height) {
-    s.backend.reset();
-    if (s.vulkan) {
-      try {
-        s.backend = make_vulkan_backend(s.vulkan, g.model_height, g.model_width);
-      } catch (const BackendError& e) {
-        if (options.backend != Backend::automatic) throw;
-        s.fallback = std::string("backend auto: ") + e.what() + "; running on the CPU instead";
-        s.vulkan.reset();
-        s.description = "cpu";
-      }
-    }
-    if (!s.backend) s.backend = make_cpu_backend(model, g.model_height, g.model_width, options.cpu_convolution);
+    s.backend.reset();  // its buffers are released before the next plan's are made
+    s.backend = s.backends->make(g.model_height, g.model_width);
   }
   s.geometry = g;
   s.has_previous = false;
@@ -181,7 +153,7 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   apply_threads(options_.threads);
   auto& s = *state_;
   finish_started(s);  // the backend computes pairs with nothing of the stream outstanding
-  const FrameGeometry& g = prepare_plan(s, *model_, options_, frame0.width, frame0.height);
+  const FrameGeometry& g = prepare_plan(s, options_, frame0.width, frame0.height);
   s.stage_times.clear();
   s.backend->take_stage_times();  // what a call that failed half-way left
   const auto [first, second] = free_slots(s.previous_slot);
@@ -203,11 +175,11 @@ namespace {
 int next_stream_slot(const FlowSession::State& s) { return s.previous_slot == 0 ? 1 : 0; }
 
 // One frame of a stream, computed now: push()'s work, without its check for frames in flight.
-std::optional<flow::FlowField> stream_now(FlowSession::State& s, const FlowModel& model, const SessionOptions& options,
-                                          const ImageView& frame, const Iterations& iterations) {
+std::optional<flow::FlowField> stream_now(FlowSession::State& s, const SessionOptions& options, const ImageView& frame,
+                                          const Iterations& iterations) {
   validate(iterations);
   apply_threads(options.threads);
-  const FrameGeometry& g = prepare_plan(s, model, options, frame.width, frame.height);
+  const FrameGeometry& g = prepare_plan(s, options, frame.width, frame.height);
   s.stage_times.clear();
   s.backend->take_stage_times();
   const int current = next_stream_slot(s);
@@ -231,7 +203,7 @@ std::optional<flow::FlowField> FlowSession::push(const ImageView& frame, const I
   if (!state_->in_flight.empty()) {
     throw std::logic_error("FlowSession::push with submitted frames not yet taken: take() them first");
   }
-  return stream_now(*state_, *model_, options_, frame, iterations);
+  return stream_now(*state_, options_, frame, iterations);
 }
 
 void FlowSession::submit(const ImageView& frame) { submit(frame, options_.iterations); }
@@ -244,12 +216,12 @@ void FlowSession::submit(const ImageView& frame, const Iterations& iterations) {
   }
   validate(iterations);
   apply_threads(options_.threads);
-  const FrameGeometry& g = prepare_plan(s, *model_, options_, frame.width, frame.height);
+  const FrameGeometry& g = prepare_plan(s, options_, frame.width, frame.height);
   check_image(frame, g);
   if (s.backend->stream_depth() == 0 || s.observer) {
     // Computed now, once the frames before it are finished (their results keep their order).
     finish_started(s);
-    s.in_flight.push_back({false, stream_now(s, *model_, options_, frame, iterations), g, nullptr});
+    s.in_flight.push_back({false, stream_now(s, options_, frame, iterations), g, nullptr});
     return;
   }
   s.backend->take_stage_times();

@@ -38,13 +38,16 @@ class WeightReader {
 
   ConvWeights conv(const std::string& name) const {
     const LayerSpec& spec = layer(name, LayerKind::conv);
-    ConvWeights c;
-    c.out_channels = spec.out;
-    c.in_channels = spec.in;
-    c.kernel_h = c.kernel_w = spec.kernel;
-    c.weight = tensor(name + ".weight", {spec.out, spec.in, spec.kernel, spec.kernel});
-    if (spec.bias) c.bias = tensor(name + ".bias", {spec.out});
-    return c;
+    return {spec.out,
+            spec.in,
+            spec.kernel,
+            spec.kernel,
+            tensor(name + ".weight", {spec.out, spec.in, spec.kernel, spec.kernel}),
+            bias(name, spec)};
+  }
+
+  std::vector<float> bias(const std::string& layer_name, const LayerSpec& spec) const {
+    return spec.bias ? tensor(layer_name + ".bias", {spec.out}) : std::vector<float>{};
   }
 
   // Per-channel affine form of an inference BatchNorm: y = x * scale + shift.
@@ -97,12 +100,7 @@ class WeightReader {
 
   LinearWeights linear(const std::string& name) const {
     const LayerSpec& spec = layer(name, LayerKind::linear);
-    LinearWeights l;
-    l.out_features = spec.out;
-    l.in_features = spec.in;
-    l.weight = tensor(name + ".weight", {spec.out, spec.in});
-    if (spec.bias) l.bias = tensor(name + ".bias", {spec.out});
-    return l;
+    return {spec.out, spec.in, tensor(name + ".weight", {spec.out, spec.in}), bias(name, spec)};
   }
 
   LayerNormWeights layer_norm(const std::string& name) const {

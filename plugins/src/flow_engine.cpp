@@ -211,8 +211,7 @@ bool FlowEngine::queue_event(GstEvent* event) {
       live_.reset();  // a new stream may come from a source of another kind
       break;
     }
-    default:
-      break;
+    default: break;
   }
   Item item{nullptr, event, 0};
   if (input_.push_other(item) != Handoff::Result::queued) {

@@ -85,6 +85,17 @@ fs::path find_base(const fs::path& root, const std::vector<std::string>& subdirs
   return found.front();
 }
 
+// A set with no pairs yet, scored and padded the way its benchmark's reference evaluation does.
+EvalSet new_set(std::string name, Dataset dataset, PadMode pad_mode, Aggregation aggregation, fs::path root) {
+  EvalSet set;
+  set.name = std::move(name);
+  set.dataset = dataset;
+  set.pad_mode = pad_mode;
+  set.aggregation = aggregation;
+  set.root = std::move(root);
+  return set;
+}
+
 std::vector<EvalSet> sintel_sets(const fs::path& root, SintelPass which) {
   std::vector<std::string> passes;
   if (which != SintelPass::final) passes.emplace_back("clean");
@@ -95,12 +106,7 @@ std::vector<EvalSet> sintel_sets(const fs::path& root, SintelPass which) {
 
   std::vector<EvalSet> sets;
   for (const auto& pass : passes) {
-    EvalSet set;
-    set.name = "sintel-" + pass;
-    set.dataset = Dataset::sintel;
-    set.pad_mode = PadMode::centred;
-    set.aggregation = Aggregation::pooled_pixels;
-    set.root = base;
+    EvalSet set = new_set("sintel-" + pass, Dataset::sintel, PadMode::centred, Aggregation::pooled_pixels, base);
     for (const auto& scene : list_names(base / "flow", true)) {
       const fs::path image_dir = base / pass / scene;
       const auto flows = list_names(base / "flow" / scene, false, ".flo");
@@ -135,12 +141,7 @@ std::vector<EvalSet> sintel_sets(const fs::path& root, SintelPass which) {
 
 EvalSet kitti_set(const fs::path& root) {
   const fs::path base = find_base(root, {"image_2", "flow_occ"}, "KITTI-2015", true);
-  EvalSet set;
-  set.name = "kitti";
-  set.dataset = Dataset::kitti;
-  set.pad_mode = PadMode::bottom;
-  set.aggregation = Aggregation::mean_of_images;
-  set.root = base;
+  EvalSet set = new_set("kitti", Dataset::kitti, PadMode::bottom, Aggregation::mean_of_images, base);
   for (const auto& name : list_names(base / "flow_occ", false, "_10.png")) {
     const std::string id = name.substr(0, name.size() - 7);
     const fs::path gt = base / "flow_occ" / name;
@@ -170,12 +171,7 @@ std::optional<std::pair<std::string, std::string>> middlebury_frames(const std::
 
 EvalSet middlebury_set(const fs::path& root) {
   const fs::path base = find_base(root, {"other-data", "other-gt-flow"}, "Middlebury", false);
-  EvalSet set;
-  set.name = "middlebury";
-  set.dataset = Dataset::middlebury;
-  set.pad_mode = PadMode::centred;
-  set.aggregation = Aggregation::pooled_pixels;
-  set.root = base;
+  EvalSet set = new_set("middlebury", Dataset::middlebury, PadMode::centred, Aggregation::pooled_pixels, base);
   for (const auto& seq : list_names(base / "other-gt-flow", true)) {
     for (const auto& flo : list_names(base / "other-gt-flow" / seq, false, ".flo")) {
       const auto frames = middlebury_frames(flo);
@@ -225,12 +221,7 @@ EvalSet chairs_set(const fs::path& root) {
     missing(root.string() + ": not a FlyingChairs layout: no *_flow.flo files in " + data.string() +
             (has_data ? "" : " (nor a data/ folder)"));
   }
-  EvalSet set;
-  set.name = "chairs";
-  set.dataset = Dataset::chairs;
-  set.pad_mode = PadMode::centred;
-  set.aggregation = Aggregation::pooled_pixels;
-  set.root = data;
+  EvalSet set = new_set("chairs", Dataset::chairs, PadMode::centred, Aggregation::pooled_pixels, data);
 
   std::vector<int> labels;
   // The release keeps the split file beside data/.
@@ -265,14 +256,10 @@ std::optional<Dataset> parse_dataset(std::string_view name) {
 
 std::string_view to_string(Dataset dataset) {
   switch (dataset) {
-    case Dataset::sintel:
-      return "sintel";
-    case Dataset::kitti:
-      return "kitti";
-    case Dataset::middlebury:
-      return "middlebury";
-    case Dataset::chairs:
-      return "chairs";
+    case Dataset::sintel: return "sintel";
+    case Dataset::kitti: return "kitti";
+    case Dataset::middlebury: return "middlebury";
+    case Dataset::chairs: return "chairs";
   }
   return "unknown";
 }
@@ -282,14 +269,10 @@ std::vector<EvalSet> discover_sets(Dataset dataset, const fs::path& given_root, 
   fs::path root = fs::absolute(given_root).lexically_normal();
   if (!root.has_filename() && root.has_parent_path() && root != root.root_path()) root = root.parent_path();
   switch (dataset) {
-    case Dataset::sintel:
-      return sintel_sets(root, options.sintel_pass);
-    case Dataset::kitti:
-      return {kitti_set(root)};
-    case Dataset::middlebury:
-      return {middlebury_set(root)};
-    case Dataset::chairs:
-      return {chairs_set(root)};
+    case Dataset::sintel: return sintel_sets(root, options.sintel_pass);
+    case Dataset::kitti: return {kitti_set(root)};
+    case Dataset::middlebury: return {middlebury_set(root)};
+    case Dataset::chairs: return {chairs_set(root)};
   }
   return {};
 }
