@@ -38,6 +38,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -45,6 +46,7 @@
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/model/network_cost.hpp"
 #include "neuflow/model/session_settings.hpp"
+#include "neuflow/model/stage_observer.hpp"
 
 namespace {
 
@@ -297,11 +299,16 @@ void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant 
 
 // The stages the per-stage benchmarks report (refinement iterations summed per scale).
 std::string stage_group(const std::string& name) {
-  if (name.rfind("refine_s8", 0) == 0 || name.rfind("corr_s8", 0) == 0) return "refine_s8";
-  if (name.rfind("refine_s16", 0) == 0 || name.rfind("corr_s16", 0) == 0) return "refine_s16";
-  if (name == "backbone_s16" || name == "backbone_s8" || name == "conv_s8") return "encode";
-  if (name == "merge_s8" || name == "context_merge_s8") return "merge_s8";
-  if (name == "flow") return "upsample";
+  namespace stage = neuflow::model::stage;
+  for (const std::string_view scale : {stage::scale_s8, stage::scale_s16}) {
+    // An iteration's stages, by the prefix its names share: refine_s8_iter…, corr_s8_iter….
+    const std::string refine = stage::refine_iteration(scale, 0), corr = stage::corr_iteration(scale, 0);
+    const auto prefix = [](const std::string& s) { return s.substr(0, s.size() - 1); };  // less the "0"
+    if (name.starts_with(prefix(refine)) || name.starts_with(prefix(corr))) return "refine_" + std::string(scale);
+  }
+  if (name == stage::backbone_s16 || name == stage::backbone_s8 || name == stage::conv_s8) return "encode";
+  if (name == stage::merge_s8 || name == stage::context_merge_s8) return std::string(stage::merge_s8);
+  if (name == stage::flow) return "upsample";
   return name;
 }
 

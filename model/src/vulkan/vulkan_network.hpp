@@ -125,7 +125,7 @@ class VulkanNetwork {
   void record_attention_layer(Recorder& r, const DeviceAttentionLayer& w, const Buffer& src, const Buffer& tgt,
                               const Buffer& out);
   void record_refinement(Recorder& r, const DeviceRefine& w, Refine& buffers, const View& f0, const View& f1,
-                         const View& flow, int iterations, const std::string& scale);
+                         const View& flow, int iterations, std::string_view scale);
   // entry: the ring entry whose buffers and timestamps the pass uses.
   const Pass& cached(const std::string& key, int entry, const std::function<void(Recorder&)>& record);
   void run(const Pass& pass);

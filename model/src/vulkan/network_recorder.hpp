@@ -1,0 +1,246 @@
+#pragma once
+// What the two halves of VulkanNetwork share (vulkan_network.cpp: buffers, the ring, recorded
+// passes; vulkan_network_record.cpp: the network as dispatches): the dispatch-size rules and
+// the Recorder that writes one pass into a command buffer.
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "network_dims.hpp"
+#include "vulkan/vulkan_network.hpp"
+
+namespace neuflow::model::vulkan {
+
+inline constexpr int kDim = kFeatureChannels;  // attention tokens' width
+// The attention's and matching's score blocks hold at most this many floats (32 MiB), well
+// inside lavapipe's 128 MiB per buffer, so memory stays O(L · block) at any size.
+inline constexpr int kScoreBlockFloats = 8 << 20;
+inline constexpr int kLocal = 256;  // invocations per workgroup of the element-wise shaders
+
+// An activation code of shaders/params/activation.h.
+using Act = int;
+
+// Element-wise shaders loop over what a capped dispatch does not cover (common.glsl).
+inline uint32_t groups(long count, long per_group) {
+  return static_cast<uint32_t>(std::clamp<long>((count + per_group - 1) / per_group, 1, 65535));
+}
+
+// The tiled products do not loop: each workgroup is one 64×64 tile, so the grid must fit.
+inline uint32_t tiles(long count, const char* what) {
+  const long n = (count + 63) / 64;
+  if (n > 65535) {
+    throw BackendError(BackendError::Kind::unavailable, std::string("a model size too large for one dispatch of ") +
+                                                            what + ": choose a smaller model-width/model-height");
+  }
+  return static_cast<uint32_t>(std::max<long>(n, 1));
+}
+
+// Records one pass: every command is preceded by a barrier that orders it after everything
+// before it (the network is a chain; there is little to overlap inside one pass). With an
+// observer, observe() ends the command buffer, runs it, reads the tensor back and goes on in
+// a fresh recording.
+class VulkanNetwork::Recorder {
+ public:
+  // marks: where the stages' timestamps go (nullptr: not timed, as with an observer).
+  // entry: the ring entry whose upload, read-back and timestamps the pass uses.
+  Recorder(VulkanNetwork& net, VkCommandBuffer commands, const StageObserver* observer,
+           std::vector<std::string>* marks = nullptr, int entry = 0)
+      : net_(net),
+        commands_(commands),
+        observer_(observer && *observer ? observer : nullptr),
+        marks_(observer_ || net.timestamps_ == VK_NULL_HANDLE ? nullptr : marks),
+        transfer_(net.ring_[static_cast<std::size_t>(entry)]),
+        query_base_(static_cast<uint32_t>(entry) * kTimestamps) {
+    begin();
+    if (marks_) {
+      vkCmdResetQueryPool(commands_, net_.timestamps_, query_base_, kTimestamps);
+      vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_, query_base_);
+    }
+  }
+
+  const Buffer& upload() const { return transfer_.upload; }
+  const Buffer& readback() const { return transfer_.readback; }
+
+  // The end of the stage `name`: a timestamp once everything recorded before it has run.
+  // Consecutive names without work between them (the backbone's outputs that the flow pass
+  // only reads) take no timestamp.
+  void mark(std::string_view name) {
+    if (!marks_ || !worked_ || marks_->size() + 1 >= kTimestamps) return;
+    marks_->emplace_back(name);
+    vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_,
+                        query_base_ + static_cast<uint32_t>(marks_->size()));
+    worked_ = false;
+  }
+
+  void begin() {
+    net_.device_.check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
+    VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    net_.device_.check(vkBeginCommandBuffer(commands_, &info), "vkBeginCommandBuffer");
+  }
+  void end() { net_.device_.check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer"); }
+  void run() {
+    end();
+    net_.device_.submit_and_wait(commands_, transfer_.fence);
+  }
+
+  // Makes a copy into a host-visible buffer visible to the host once the fence has signalled.
+  void host_barrier() {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr, 0,
+                         nullptr);
+  }
+
+  void barrier() {
+    worked_ = true;  // every command is recorded after its barrier
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                      VK_ACCESS_TRANSFER_WRITE_BIT;
+    const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    vkCmdPipelineBarrier(commands_, stages, stages, 0, 1, &b, 0, nullptr, 0, nullptr);
+  }
+
+  // S's push constants are its params header's struct (ShaderParams), so recording a shader with
+  // another's parameters does not compile.
+  template <Shader S>
+  void dispatch(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, uint32_t gx,
+                uint32_t gy = 1) {
+    record_dispatch(S, bindings, &push, sizeof push, gx, gy);
+  }
+
+  void record_dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
+                       uint32_t gx, uint32_t gy) {
+    barrier();
+    std::array<VkBuffer, 4> handles{};
+    for (std::size_t i = 0; i < handles.size(); ++i) {
+      handles[i] = (bindings[i] ? *bindings[i] : net_.dummy_).handle();
+    }
+    VkDescriptorSet set = net_.descriptor_set(handles);
+    vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader, net_.fp16_));
+    vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline_layout(), 0, 1, &set, 0,
+                            nullptr);
+    vkCmdPushConstants(commands_, net_.device_.pipeline_layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       static_cast<uint32_t>(bytes), push);
+    vkCmdDispatch(commands_, gx, gy, 1);
+  }
+
+  void copy(const View& src, const View& dst) {
+    barrier();
+    const VkDeviceSize e = net_.elem_;
+    const VkBufferCopy region{static_cast<VkDeviceSize>(src.offset()) * e, static_cast<VkDeviceSize>(dst.offset()) * e,
+                              static_cast<VkDeviceSize>(src.count()) * e};
+    vkCmdCopyBuffer(commands_, src.buffer->handle(), dst.buffer->handle(), 1, &region);
+  }
+  void copy_raw(const Buffer& src, const Buffer& dst, std::size_t values) {
+    barrier();
+    const VkBufferCopy region{0, 0, values * net_.elem_};
+    vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), 1, &region);
+  }
+  // A copy of the zero buffer: vkCmdFillBuffer needs 4-byte alignment, which 16-bit values
+  // at an odd offset do not have.
+  void zero(const View& dst) {
+    barrier();
+    const VkBufferCopy region{0, static_cast<VkDeviceSize>(dst.offset()) * net_.elem_,
+                              static_cast<VkDeviceSize>(dst.count()) * net_.elem_};
+    vkCmdCopyBuffer(commands_, net_.zeros_.handle(), dst.buffer->handle(), 1, &region);
+  }
+
+  // out = act(conv(in) + bias (+ addend)); out.c must be the layer's output channels.
+  void conv(const DeviceConv& w, const View& in, int stride, int pad, Act act, const View& out,
+            const View* addend = nullptr) {
+    const Conv2dParams p{in.c,
+                         in.h,
+                         in.w,
+                         in.offset(),
+                         out.c,
+                         out.h,
+                         out.w,
+                         out.offset(),
+                         w.kernel_h,
+                         stride,
+                         pad,
+                         act,
+                         w.weight.offset,
+                         w.bias.offset,
+                         addend ? addend->offset() : -1,
+                         1.f};
+    dispatch<Shader::conv2d>({&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, p,
+                             tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
+  }
+
+  // Token lists [features][tokens]: out = act(W · in + b).
+  void linear(const DeviceLinear& w, const Buffer& in, int in_off, const Buffer& out, int out_off, int tokens,
+              Act act = kActNone) {
+    const MatmulParams p{w.out_features,  tokens,        w.in_features,
+                         w.weight.offset, w.in_features, 1,
+                         in_off,          tokens,        1,
+                         out_off,         tokens,        1,
+                         w.bias.offset,   act,           1.f};
+    dispatch<Shader::matmul>({&net_.weights_->buffer, &in, &out, nullptr}, p, tiles(tokens, "attention"),
+                             tiles(w.out_features, "attention"));
+  }
+
+  void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulParams& p) {
+    dispatch<Shader::matmul>({&a, &b, &c, nullptr}, p, tiles(p.n, "attention"), tiles(p.m, "attention"));
+  }
+
+  void resample(const View& src, const View& dst, int factor, bool relu, float scale) {
+    const ResampleParams p{src.c, src.h, src.w, src.offset(), dst.offset(), factor, relu ? 1 : 0, scale};
+    dispatch<Shader::resample>({src.buffer, nullptr, dst.buffer, nullptr}, p,
+                               groups(static_cast<long>(dst.count()), kLocal));
+  }
+
+  void avgpool(const View& src, const View& dst) {
+    const Avgpool2xParams p{src.c, src.h, src.w};
+    dispatch<Shader::avgpool2x>({src.buffer, nullptr, dst.buffer, nullptr}, p,
+                                groups(static_cast<long>(dst.count()), kLocal));
+  }
+
+  void axpby(float a, const View& x, float b, const View& y, const View& out) {
+    const AxpbyParams p{out.count(), x.offset(), y.offset(), out.offset(), a, b};
+    dispatch<Shader::axpby>({x.buffer, y.buffer, out.buffer, nullptr}, p, groups(out.count(), kLocal));
+  }
+
+  // Reads `v` back and hands it to the observer as NHWC (only when observing).
+  void observe(std::string_view name, int frame, const View& v) {
+    if (!observer_) {
+      mark(name);
+      return;
+    }
+    barrier();
+    const VkDeviceSize e = net_.elem_;
+    const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
+    vkCmdCopyBuffer(commands_, v.buffer->handle(), transfer_.readback.handle(), 1, &region);
+    host_barrier();
+    run();
+    net_.staging_.resize(static_cast<std::size_t>(v.count()));
+    net_.load(transfer_.readback.mapped(), net_.staging_.size(), net_.staging_.data());
+    const float* planar = net_.staging_.data();
+    const std::size_t plane = static_cast<std::size_t>(v.h) * v.w;
+    nhwc_.resize(plane * v.c);
+    for (int c = 0; c < v.c; ++c) {
+      for (std::size_t p = 0; p < plane; ++p) nhwc_[p * v.c + c] = planar[c * plane + p];
+    }
+    const std::string stage_name(name);
+    (*observer_)(StageTensor{stage_name, frame, v.h, v.w, v.c, nhwc_.data()});
+    begin();
+  }
+  bool observing() const { return observer_ != nullptr; }
+
+ private:
+  VulkanNetwork& net_;
+  VkCommandBuffer commands_;
+  const StageObserver* observer_;
+  std::vector<std::string>* marks_;
+  const Transfer& transfer_;
+  uint32_t query_base_;
+  bool worked_ = false;  // commands recorded since the last timestamp
+  std::vector<float> nhwc_;
+};
+
+}  // namespace neuflow::model::vulkan
