@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "neuflow/model/architecture.hpp"
 
@@ -164,12 +165,11 @@ class WeightReader {
 NetworkWeights build_network_weights(const Checkpoint& checkpoint) {
   const WeightReader r(checkpoint);
   NetworkWeights n;
-  n.block_8_1 = r.conv_block("backbone.block_8_1");
-  n.block_8_2 = r.conv_block("backbone.block_8_2");
-  n.block_cat_8 = r.conv_block("backbone.block_cat_8");
-  n.block_16_1 = r.conv_block("backbone.block_16_1");
-  n.block_8_16 = r.conv_block("backbone.block_8_16");
-  n.block_cat_16 = r.conv_block("backbone.block_cat_16");
+  for (auto [block, name] : {std::pair{&n.block_8_1, "block_8_1"}, std::pair{&n.block_8_2, "block_8_2"},
+                             std::pair{&n.block_cat_8, "block_cat_8"}, std::pair{&n.block_16_1, "block_16_1"},
+                             std::pair{&n.block_8_16, "block_8_16"}, std::pair{&n.block_cat_16, "block_cat_16"}}) {
+    *block = r.conv_block(std::string("backbone.") + name);
+  }
   n.attention[0] = r.attention_layer("cross_attn_s16.layers.0");
   n.attention[1] = r.attention_layer("cross_attn_s16.layers.1");
   r.batch_norm("cross_attn_s16.norm", n.attention_norm_scale, n.attention_norm_shift);
@@ -182,9 +182,10 @@ NetworkWeights build_network_weights(const Checkpoint& checkpoint) {
   n.refine_s16 = r.refine("refine_s16");
   n.refine_s8 = r.refine("refine_s8");
   n.conv_s8 = r.conv_block("conv_s8");
-  n.upsample_conv1 = r.conv("upsample_s8.conv1");
-  n.upsample_conv2 = r.conv("upsample_s8.conv2");
-  n.upsample_conv3 = r.conv("upsample_s8.conv3");
+  for (auto [conv, name] : {std::pair{&n.upsample_conv1, "conv1"}, std::pair{&n.upsample_conv2, "conv2"},
+                            std::pair{&n.upsample_conv3, "conv3"}}) {
+    *conv = r.conv(std::string("upsample_s8.") + name);
+  }
   return n;
 }
 
