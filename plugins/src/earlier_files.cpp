@@ -1,9 +1,12 @@
 #include "earlier_files.hpp"
 
+#include <glib.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string_view>
 #include <system_error>
@@ -15,10 +18,22 @@ namespace fs = std::filesystem;
 
 // A file-name pattern split around its one integer conversion.
 struct NamePattern {
+  std::string pattern;  // as given (printf-style, %% for a percent sign)
   std::string prefix;
   std::string suffix;
   int base = 10;
 };
+
+// What the sink names file `index` (gstneuflowsink.cpp formats it the same way).
+std::string format_name(const std::string& pattern, int index) {
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+  gchar* name = g_strdup_printf(pattern.c_str(), index);
+#pragma GCC diagnostic pop
+  std::string out(name);
+  g_free(name);
+  return out;
+}
 
 std::string unescape_percent(std::string_view text) {
   std::string out;
@@ -49,6 +64,7 @@ std::optional<NamePattern> split(const std::string& name) {
       case 'o': p.base = 8; break;
       default: return std::nullopt;
     }
+    p.pattern = name;
     p.prefix = unescape_percent(std::string_view(name).substr(0, i));
     p.suffix = unescape_percent(std::string_view(name).substr(k + 1));
     return p;
@@ -62,20 +78,23 @@ bool is_digit_in(char c, int base) {
   return false;
 }
 
-// The index in `name`, when the pattern produces it.
+// The index in `name`, when the pattern produces exactly this name for it: the sink's indices
+// are ints from 0, so digits only (no sign), and formatting the index again must give the name
+// back (the same width and padding): "flow_7.flo" is not what "flow_%08d.flo" writes.
 std::optional<std::int64_t> index_in(const std::string& name, const NamePattern& p) {
   if (name.size() <= p.prefix.size() + p.suffix.size()) return std::nullopt;
   if (name.compare(0, p.prefix.size(), p.prefix) != 0) return std::nullopt;
   if (name.compare(name.size() - p.suffix.size(), p.suffix.size(), p.suffix) != 0) return std::nullopt;
   const std::string digits = name.substr(p.prefix.size(), name.size() - p.prefix.size() - p.suffix.size());
-  std::size_t start = digits[0] == '-' ? 1 : 0;
-  // More than 15 digits is not a number this sink wrote (its index is an int).
-  if (digits.size() == start || digits.size() > 15) return std::nullopt;
-  if (!std::all_of(digits.begin() + static_cast<long>(start), digits.end(),
-                   [&](char c) { return is_digit_in(c, p.base); })) {
+  // An int has at most 11 digits in base 8; longer is not a number this sink wrote.
+  if (digits.size() > 11 ||
+      !std::all_of(digits.begin(), digits.end(), [&](char c) { return is_digit_in(c, p.base); })) {
     return std::nullopt;
   }
-  return std::stoll(digits, nullptr, p.base);
+  const long long index = std::stoll(digits, nullptr, p.base);
+  if (index > std::numeric_limits<int>::max()) return std::nullopt;
+  if (format_name(p.pattern, static_cast<int>(index)) != name) return std::nullopt;
+  return index;
 }
 
 // "flow_00001.flo" from ".flow_00001.flo.tmp-0123abcd", or nothing.

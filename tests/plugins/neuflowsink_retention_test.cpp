@@ -251,20 +251,53 @@ TEST(NeuflowSinkRetention, TemporariesOfInterruptedWritesAreRemovedAtStart) {
 
 TEST(EarlierFiles, TheNamesAPatternMakesAreFoundInIndexOrder) {
   TempDir dir;
-  for (const char *name : {"f_10.flo", "f_9.flo", "f_0100.flo", "f_x.flo", "g_1.flo", "f_2.npy", "f_-3.flo"}) {
+  for (const char *name :
+       {"f_10.flo", "f_9.flo", "f_0100.flo", "f_x.flo", "g_1.flo", "f_2.npy", "f_-3.flo", "f_ff.flo"}) {
     std::ofstream(dir / name) << name;
   }
   std::filesystem::create_directory(dir / "f_5.flo");
   const auto found = gst::files_matching((dir / "f_%d.flo").string());
   std::vector<std::int64_t> indices;
   for (const auto &f : found) indices.push_back(f.index);
-  EXPECT_EQ(indices, (std::vector<std::int64_t>{-3, 9, 10, 100}));
-  EXPECT_EQ(found[1].bytes, 7u);
+  // Not f_0100 (%d writes 100 as "100"), not f_-3 (indices start at 0).
+  EXPECT_EQ(indices, (std::vector<std::int64_t>{9, 10}));
+  EXPECT_EQ(found[0].bytes, 7u);
   const auto hex = gst::files_matching((dir / "f_%x.flo").string());
-  ASSERT_EQ(hex.size(), 4u);
-  EXPECT_EQ(hex.back().index, 0x100);
+  ASSERT_EQ(hex.size(), 3u);  // 9, 0x10, 0xff
+  EXPECT_EQ(hex.back().index, 0xff);
   std::ofstream(dir / "50%_1.flo") << "x";
   EXPECT_EQ(gst::files_matching((dir / "50%%_%d.flo").string()).size(), 1u);
+}
+
+// Only what the pattern writes counts: the same width and zero padding, digits only, no sign.
+TEST(EarlierFiles, OtherToolsFilesBesideThePatternAreNotTheSinks) {
+  TempDir dir;
+  for (const char *name : {"flow_7.flo", "flow_-5.flo", "flow_123456789012345.flo", "flow_0000007.flo",
+                           "flow_+0000007.flo", "flow_ 0000007.flo", "flow_00000007.flo"}) {
+    std::ofstream(dir / name) << name;
+  }
+  const auto found = gst::files_matching((dir / "flow_%08d.flo").string());
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(std::filesystem::path(found[0].path).filename(), "flow_00000007.flo");
+  EXPECT_EQ(found[0].index, 7);
+}
+
+// The audit's case: a 12-flow run with max-files = 3 in a folder holding other files whose names
+// look numbered keeps them all.
+TEST(NeuflowSinkRetention, RetentionLeavesFilesThePatternDoesNotProduce) {
+  TempDir dir;
+  const std::vector<std::string> others = {"flow_-5.flo", "flow_123456789012345.flo", "flow_7.flo"};
+  for (const auto &name : others) std::ofstream(dir / name) << name;
+  auto s = start_sink("neuflowsink", {{"location", (dir / "flow_%08d.flo").string()}, {"max-files", "3"}});
+  ASSERT_TRUE(s.harness);
+  for (int n = 0; n < 12; ++n) ASSERT_EQ(s.push(buffer_with_flow(nth_flow(n))), GST_FLOW_OK);
+  s.stop();
+  const std::vector<std::string> entries = dir.entries();
+  for (const auto &name : others) {
+    EXPECT_NE(std::find(entries.begin(), entries.end(), name), entries.end()) << name << " was removed";
+  }
+  EXPECT_NE(std::find(entries.begin(), entries.end(), "flow_00000011.flo"), entries.end());
+  EXPECT_EQ(std::find(entries.begin(), entries.end(), "flow_00000008.flo"), entries.end());
 }
 
 TEST(WrittenFiles, OldestGoFirstAndARewrittenPathCountsOnceAtItsNewestPosition) {
