@@ -109,6 +109,15 @@ std::string check_index_pattern(std::string_view file_name) {
     if (j >= file_name.size() || file_name[j] != 'd') {
       return "at most one number conversion like %05d (write %% for a literal %)";
     }
+    // Wider than an index's digits only pads the name (%99999d: names of 100 kB, which no file
+    // system takes).
+    const std::string_view width = file_name.substr(i + 1, j - i - 1);  // with its '0' flag, if any
+    const std::size_t first = width.find_first_not_of('0');
+    const std::string_view value = first == std::string_view::npos ? std::string_view{} : width.substr(first);
+    if (value.size() > 2 || (!value.empty() && std::stoi(std::string(value)) > kMaxIndexWidth)) {
+      return "a number conversion at most " + std::to_string(kMaxIndexWidth) + " digits wide like %05d, found %" +
+             std::string(width) + "d";
+    }
     ++conversions;
     i = j;
   }

@@ -31,8 +31,10 @@ std::optional<unsigned> parse_octal_mode(std::string_view text);
 // An RTSP server mount point: "/front", "/cameras/front".
 std::string check_rtsp_mount(std::string_view mount);
 
-// A file name that may hold one printf integer conversion for a running number ("%05d");
-// anything else would be handed to printf by the muxer. "%%" is a literal '%'.
+// A file name that may hold one printf integer conversion for a running number ("%05d", at
+// most kMaxIndexWidth wide); anything else would be handed to printf by the muxer. "%%" is a
+// literal '%'.
+inline constexpr int kMaxIndexWidth = 10;  // an int's digits
 std::string check_index_pattern(std::string_view file_name);
 
 // "30000/1001": both positive.

@@ -742,6 +742,12 @@ flow = { model = "/m" }
   type = "video"
   file = "/v/100%%-%03d.mp4"
   segment-seconds = 60
+  [[stream.sink]]
+  type = "video"
+  file = "/v/v-%99999d.mp4"
+  [[stream.sink]]
+  type = "video"
+  file = "/v/w-%010d.mp4"
 )");
   EXPECT_TRUE(has_issue(issues, 8, 10, "file: expected a file name ending in .mp4 or .mkv, got \"/v/out.avi\""));
   EXPECT_TRUE(has_issue(issues, 11, 10,
@@ -750,7 +756,10 @@ flow = { model = "/m" }
   EXPECT_TRUE(has_issue(issues, 14, 10, "found 2"));
   EXPECT_TRUE(has_issue(issues, 18, 10, "rtsp: give exactly one of file, rtsp, udp; file is already set"));
   EXPECT_TRUE(has_issue(issues, 22, 21, "segment-seconds: applies only to a video sink with file = \"...\""));
-  EXPECT_EQ(issues.size(), 5u) << test::listed(issues);
+  // A width past an index's digits would make names no file system takes.
+  EXPECT_TRUE(
+      has_issue(issues, 29, 10, "file: expected a number conversion at most 10 digits wide like %05d, found %99999d"));
+  EXPECT_EQ(issues.size(), 6u) << test::listed(issues);
 }
 
 TEST(ConfigErrors, UriSourceTakesUriOrPathNotBoth) {
