@@ -16,7 +16,8 @@ packages=(
   libcli11-dev                      # command-line parsing
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer plugin
   gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-tools
-  gstreamer1.0-plugins-bad          # intervideo (RTSP mounts), h264parse
+  gstreamer1.0-plugins-bad          # intervideo (RTSP mounts), h264parse, waylandsink
+  gstreamer1.0-x                    # ximagesink: a neuflowd display sink under X11
   gstreamer1.0-plugins-ugly         # x264enc: the encoded visualization
   gstreamer1.0-libav                # decoders for common video files (e.g. vtest.avi's MS-MPEG4)
   gstreamer1.0-rtsp libgstrtspserver-1.0-dev   # neuflowd's RTSP server mounts

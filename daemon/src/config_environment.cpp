@@ -15,6 +15,7 @@
 #include "neuflow/model/architecture.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/gpu_devices.hpp"
+#include "neuflow/pipeline/graph_plan.hpp"
 
 namespace neuflow::daemon {
 namespace {
@@ -130,14 +131,23 @@ void check_writable_directory(const PathNeed& need, Issues& issues) {
 
 std::string debian_package(const std::string& factory) {
   static const std::map<std::string, std::string> packages = {
-      {"v4l2src", "gstreamer1.0-plugins-good"},       {"jpegdec", "gstreamer1.0-plugins-good"},
-      {"splitmuxsink", "gstreamer1.0-plugins-good"},  {"mp4mux", "gstreamer1.0-plugins-good"},
-      {"matroskamux", "gstreamer1.0-plugins-good"},   {"rtph264pay", "gstreamer1.0-plugins-good"},
-      {"udpsink", "gstreamer1.0-plugins-good"},       {"autovideosink", "gstreamer1.0-plugins-good"},
-      {"libcamerasrc", "gstreamer1.0-libcamera"},     {"uridecodebin", "gstreamer1.0-plugins-base"},
-      {"videotestsrc", "gstreamer1.0-plugins-base"},  {"videoconvert", "gstreamer1.0-plugins-base"},
-      {"x264enc", "gstreamer1.0-plugins-ugly"},       {"h264parse", "gstreamer1.0-plugins-bad"},
-      {"intervideosink", "gstreamer1.0-plugins-bad"}, {"intervideosrc", "gstreamer1.0-plugins-bad"},
+      {"v4l2src", "gstreamer1.0-plugins-good"},
+      {"jpegdec", "gstreamer1.0-plugins-good"},
+      {"splitmuxsink", "gstreamer1.0-plugins-good"},
+      {"mp4mux", "gstreamer1.0-plugins-good"},
+      {"matroskamux", "gstreamer1.0-plugins-good"},
+      {"rtph264pay", "gstreamer1.0-plugins-good"},
+      {"udpsink", "gstreamer1.0-plugins-good"},
+      {"waylandsink", "gstreamer1.0-plugins-bad"},
+      {"ximagesink", "gstreamer1.0-x"},
+      {"libcamerasrc", "gstreamer1.0-libcamera"},
+      {"uridecodebin", "gstreamer1.0-plugins-base"},
+      {"videotestsrc", "gstreamer1.0-plugins-base"},
+      {"videoconvert", "gstreamer1.0-plugins-base"},
+      {"x264enc", "gstreamer1.0-plugins-ugly"},
+      {"h264parse", "gstreamer1.0-plugins-bad"},
+      {"intervideosink", "gstreamer1.0-plugins-bad"},
+      {"intervideosrc", "gstreamer1.0-plugins-bad"},
   };
   const auto it = packages.find(factory);
   return it == packages.end() ? std::string() : it->second;
@@ -211,6 +221,15 @@ void check_gpus(const std::vector<GpuNeed>& needs, Issues& issues) {
   }
 }
 
+// A display sink where there is no display is cut off at start (its stream goes on): say so now.
+void check_displays(const std::vector<DisplayNeed>& needs, Issues& issues) {
+  if (pipeline::display_server_from_environment() != pipeline::DisplayServer::none) return;
+  for (const auto& need : needs) {
+    issues.add(need.where, "type: " + need.user + " shows a window, but there is " + pipeline::no_display_reason() +
+                               ": it will be cut off when the stream starts, and the stream's other sinks go on");
+  }
+}
+
 void check_uri_schemes(const std::vector<UriSchemeNeed>& needs, const GstInventory& gstreamer, Issues& issues) {
   std::set<std::string> reported;
   for (const auto& need : needs) {
@@ -250,6 +269,7 @@ void check_machine(const MachineNeeds& needs, const GstInventory& gstreamer, Iss
   check_elements(needs.elements, gstreamer, issues);
   check_uri_schemes(needs.uri_schemes, gstreamer, issues);
   check_gpus(needs.gpus, issues);
+  check_displays(needs.displays, issues);
 }
 
 }  // namespace neuflow::daemon

@@ -49,8 +49,15 @@ struct GpuNeed {
   SourcePosition where;
 };
 
+// type = "display": a window needs a graphical session.
+struct DisplayNeed {
+  std::string user;  // "the display sink 'screen' of stream 'front'"
+  SourcePosition where;
+};
+
 struct MachineNeeds {
   std::vector<PathNeed> paths;
+  std::vector<DisplayNeed> displays;
   std::vector<GpuNeed> gpus;
   std::vector<ElementNeed> elements;
   std::vector<UriSchemeNeed> uri_schemes;

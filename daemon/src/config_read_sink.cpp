@@ -172,7 +172,10 @@ bool read_sink(const TableReader& t, std::size_t index, const std::string& strea
   if (*type == "files") out.settings = read_files(t, user, context);
   if (*type == "shm") out.settings = read_shm(t, user, context);
   if (*type == "video") out.settings = read_video(t, user, context);
-  if (*type == "display") out.settings = read_display(t);
+  if (*type == "display") {
+    out.settings = read_display(t);
+    context.needs.displays.push_back({user, t.position("type")});
+  }
   context.need_elements(pipeline::required_elements(out.settings), user, out.where);
   return true;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <stdexcept>
 #include <system_error>
 
@@ -143,9 +144,11 @@ SinkPlan plan_sink(const std::string& graph, const NamedSink& sink, const PlanCo
     return plan;
   }
   if (const auto* d = std::get_if<DisplaySink>(&sink.settings)) {
+    const DisplayServer server = context.display_server();
+    if (server == DisplayServer::none) throw std::runtime_error(no_display_reason());
     plan.chain = {leaky_queue(p + "queue"), visualizer(p + "viz", d->max_flow), element("videoconvert", p + "convert"),
-                  // A bin: it has no `async`, but settles its own preroll.
-                  element("autovideosink", p + "display").set("sync", "false").set("async-handling", "true")};
+                  no_preroll(element(server == DisplayServer::wayland ? "waylandsink" : "ximagesink", p + "display"))
+                      .set("sync", "false")};
     return plan;
   }
   const auto& v = std::get<VideoSink>(sink.settings);
@@ -193,7 +196,25 @@ std::vector<std::string> required_elements(const SourceDescription& source) {
 
 std::vector<std::string> required_elements(const FlowStage& flow) { return factories_of(plan_flow(flow)); }
 
+DisplayServer display_server_from_environment() {
+  const auto set = [](const char* name) {
+    const char* value = std::getenv(name);
+    return value && *value;
+  };
+  if (set("WAYLAND_DISPLAY")) return DisplayServer::wayland;
+  if (set("DISPLAY")) return DisplayServer::x11;
+  return DisplayServer::none;
+}
+
+std::string no_display_reason() {
+  return "no display to open a window on (neither WAYLAND_DISPLAY nor DISPLAY is set; a display sink needs a "
+         "graphical session)";
+}
+
 std::vector<std::string> required_elements(const SinkDescription& sink) {
+  // Without a display a display sink is cut off when its stream starts (neuflowd --check-config
+  // warns): it needs nothing here.
+  if (std::holds_alternative<DisplaySink>(sink) && display_server_from_environment() == DisplayServer::none) return {};
   ElementChain chain = plan_sink("graph", NamedSink{"sink", sink}).chain;
   if (const auto* v = std::get_if<VideoSink>(&sink); v && v->target == VideoSink::Target::rtsp) {
     const ElementChain server = rtsp_media_chain("channel", v->bitrate_kbps);

@@ -9,8 +9,10 @@
 #include <toml++/toml.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -51,6 +53,44 @@ void write_file(const fs::path& path, const std::string& content = "x") { std::o
 void write_model(const fs::path& path) { neuflow::test::fake_neuflow_checkpoint().write(path); }
 
 bool running_as_root() { return ::geteuid() == 0; }
+
+// The checks run as in a (Wayland) desktop session, so the display sinks these tests use as the
+// simplest sink need only waylandsink (gstreamer1.0-plugins-bad, which the build installs); the
+// test of a machine without a display unsets it.
+class DesktopSession : public ::testing::Environment {
+ public:
+  void SetUp() override {
+    unsetenv("DISPLAY");
+    setenv("WAYLAND_DISPLAY", "wayland-neuflow-test", 1);
+  }
+};
+const ::testing::Environment* const kDesktopSession = ::testing::AddGlobalTestEnvironment(new DesktopSession);
+
+// Sets or unsets an environment variable for one scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    if (value) {
+      setenv(name, value, 1);
+    } else {
+      unsetenv(name);
+    }
+  }
+  ~ScopedEnv() {
+    if (old_) {
+      setenv(name_, old_->c_str(), 1);
+    } else {
+      unsetenv(name_);
+    }
+  }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
 
 // A stream with the given source and sinks, and a model path.
 std::string stream(const std::string& source, const std::string& model, const std::string& sinks) {
@@ -317,6 +357,24 @@ sink = [ { type = "display" } ]
 
 // backend = "vulkan" needs Vulkan and the device; the issue points at the key. backend = "auto"
 // needs neither (it falls back to the CPU).
+// Without a graphical session a display sink would be cut off at start: a warning that says so,
+// at the sink's type; with one, nothing.
+TEST(ConfigMachine, ADisplaySinkWithoutADisplayIsAWarning) {
+  TempFolder folder;
+  write_model(folder / "m.pth");
+  const fs::path file = folder / "neuflowd.toml";
+  const std::string text =
+      stream("{ type = \"test\" }", "m.pth", "sink = [ { type = \"display\", name = \"screen\" } ]\n");
+  EXPECT_TRUE(machine_issues(text, inventory_without({}), file).empty());
+  const ScopedEnv no_x11("DISPLAY", nullptr), no_wayland("WAYLAND_DISPLAY", nullptr);
+  const auto issues = machine_issues(text, inventory_without({}), file);
+  ASSERT_EQ(issues.size(), 1u) << test::listed(issues);
+  EXPECT_TRUE(has_issue(issues, 5, 19,
+                        "type: the display sink 'screen' of stream 's' shows a window, but there is no display to "
+                        "open a window on (neither WAYLAND_DISPLAY nor DISPLAY is set"))
+      << test::listed(issues);
+}
+
 TEST(ConfigMachine, AVulkanDeviceMustExist) {
   TempFolder folder;
   write_model(folder / "m.pth");

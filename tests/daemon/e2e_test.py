@@ -93,7 +93,11 @@ class Daemon:
         self.log_path = os.path.join(folder, "neuflowd.log")
         env = dict(os.environ)
         env["NOTIFY_SOCKET"] = self.notify.path
-        env.update(extra_env or {})
+        for key, value in (extra_env or {}).items():  # None: not in the daemon's environment
+            if value is None:
+                env.pop(key, None)
+            else:
+                env[key] = value
         self.log = open(self.log_path, "w")
         def limit_files():
             if max_open_files:
@@ -666,6 +670,32 @@ class DaemonReliability(DaemonTestCase):
         d.wait_ready(60)
         d.wait_log(r"stream s: sink forbidden cannot be built: .*other sinks", timeout=30)
         wait_until(lambda: len(flow_files(kept)) >= 5, 60, "the healthy sink wrote no flows")
+        self.assertNotIn("restarting in", d.log_text())
+        self.assertEqual(d.stop(), 0)
+
+    def test_a_display_sink_without_a_display_is_cut_off_and_the_daemon_runs_on(self):
+        # autovideosink's probe of kmssink/dfbvideosink used to take the whole process down
+        # (exit 139) here; now the window sink follows the environment, and without a display
+        # the sink is cut off with its reason.
+        kept = os.path.join(self.dir, "kept")
+        text = stream_block("s", test_source(), [
+            f'  type = "files"\n  name = "kept"\n  directory = "{kept}"',
+            '  type = "display"\n  name = "screen"',
+        ])
+        no_display = {"DISPLAY": None, "WAYLAND_DISPLAY": None}
+        check_env = {k: v for k, v in os.environ.items() if k not in no_display}
+        path = os.path.join(self.dir, "check.toml")
+        with open(path, "w") as f:
+            f.write(text)
+        check = subprocess.run([os.environ["NEUFLOWD"], "--check-config", path], capture_output=True, text=True,
+                               timeout=60, env=check_env)
+        self.assertEqual(check.returncode, 0, check.stderr)
+        self.assertRegex(check.stderr, r":\d+:\d+: warning: type: the display sink .screen. .*neither "
+                                       r"WAYLAND_DISPLAY nor DISPLAY is set.*cut off")
+        d = self.start(text, extra_env=no_display)
+        d.wait_ready(60)
+        d.wait_log(r"stream s: sink screen cannot be built: no display .*other sinks", timeout=30)
+        wait_until(lambda: len(flow_files(kept)) >= 5, 60, "the files sink wrote no flows")
         self.assertNotIn("restarting in", d.log_text())
         self.assertEqual(d.stop(), 0)
 

@@ -43,6 +43,7 @@ foreach(test_case
     CheckConfig.test_missing_model_is_a_warning_and_the_stream_waits_for_it
     DaemonReliability.test_missing_camera_and_input_file_leave_the_other_streams_running
     DaemonReliability.test_a_sink_that_cannot_be_built_is_cut_off_at_start
+    DaemonReliability.test_a_display_sink_without_a_display_is_cut_off_and_the_daemon_runs_on
     DaemonReliability.test_a_flood_of_idle_metrics_connections_starves_nothing
     DaemonReliability.test_reload_keeps_counters_and_retention_counts_earlier_files
     DaemonReliability.test_memory_after_alternating_reloads_stays_near_a_fresh_start)

@@ -4,7 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
+#include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "neuflow/pipeline/element_chain.hpp"
 #include "neuflow/pipeline/graph_plan.hpp"
@@ -50,6 +54,48 @@ TEST(GraphPlan, RequiredElementsFollowWhatIsBuilt) {
     EXPECT_TRUE(contains(rtsp, e)) << e;
   const auto udp = required_elements(SinkDescription{video_to(VideoSink::Target::udp)});
   for (const char* e : {"x264enc", "rtph264pay", "udpsink"}) EXPECT_TRUE(contains(udp, e)) << e;
+}
+
+// The window sink follows the environment, never a probe (autovideosink's in-process probing
+// crashed the daemon without a display); without a display the sink cannot be built, and says why.
+TEST(GraphPlan, ADisplaySinkTakesTheWindowSinkOfTheSessionItRunsIn) {
+  const NamedSink display{"screen", DisplaySink{}};
+  const auto plan_with = [&](DisplayServer server) {
+    PlanContext context;
+    context.display_server = [server] { return server; };
+    return plan_sink("g", display, context);
+  };
+  EXPECT_EQ(plan_with(DisplayServer::wayland).chain.back().factory, "waylandsink");
+  EXPECT_EQ(plan_with(DisplayServer::x11).chain.back().factory, "ximagesink");
+  EXPECT_EQ(plan_with(DisplayServer::x11).chain.back().name, "screen-display");
+  try {
+    plan_with(DisplayServer::none);
+    FAIL() << "a display sink without a display was planned";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("neither WAYLAND_DISPLAY nor DISPLAY is set"), std::string::npos) << e.what();
+  }
+  for (const auto& element : plan_with(DisplayServer::x11).chain) EXPECT_NE(element.factory, "autovideosink");
+}
+
+TEST(GraphPlan, TheDisplayServerComesFromTheEnvironment) {
+  const auto saved = [](const char* name) {
+    const char* v = std::getenv(name);
+    return v ? std::optional<std::string>(v) : std::nullopt;
+  };
+  const auto wayland = saved("WAYLAND_DISPLAY"), x11 = saved("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  unsetenv("DISPLAY");
+  EXPECT_EQ(display_server_from_environment(), DisplayServer::none);
+  EXPECT_TRUE(required_elements(SinkDescription{DisplaySink{}}).empty()) << "cut off at start: needs nothing";
+  setenv("DISPLAY", ":0", 1);
+  EXPECT_EQ(display_server_from_environment(), DisplayServer::x11);
+  EXPECT_TRUE(contains(required_elements(SinkDescription{DisplaySink{}}), "ximagesink"));
+  setenv("WAYLAND_DISPLAY", "wayland-0", 1);
+  EXPECT_EQ(display_server_from_environment(), DisplayServer::wayland);
+  unsetenv("WAYLAND_DISPLAY");
+  unsetenv("DISPLAY");
+  if (wayland) setenv("WAYLAND_DISPLAY", wayland->c_str(), 1);
+  if (x11) setenv("DISPLAY", x11->c_str(), 1);
 }
 
 TEST(GraphPlan, SinkKindsNameEachOutput) {

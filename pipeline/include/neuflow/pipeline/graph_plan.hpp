@@ -27,10 +27,21 @@ struct SinkPlan {
 };
 
 // What a plan may need to know of the machine; the defaults know nothing.
+// Where a display sink can show its window, from the environment alone: a Wayland compositor
+// (WAYLAND_DISPLAY), an X server (DISPLAY), or none. Never by probing: autovideosink tries
+// kmssink and dfbvideosink in-process, which crashed the whole daemon on a machine without a
+// display.
+enum class DisplayServer { none, wayland, x11 };
+DisplayServer display_server_from_environment();
+// Why a display sink cannot be built where there is no display.
+std::string no_display_reason();
+
 struct PlanContext {
   // The first file index not used yet by files matching a printf-style pattern, so a restarted
   // stream never overwrites what an earlier run wrote.
   std::function<int(const std::string& pattern)> first_free_index = [](const std::string&) { return 0; };
+  // A display sink's window: waylandsink, ximagesink, or (none) a sink that cannot be built.
+  std::function<DisplayServer()> display_server = display_server_from_environment;
 };
 
 SourcePlan plan_source(const SourceDescription& source);
