@@ -87,7 +87,7 @@ std::optional<unsigned> parse_octal_mode(std::string_view text) {
 }
 
 std::string check_rtsp_mount(std::string_view mount) {
-  const std::string expected = "a mount point like \"/front\": '/' then A-Z a-z 0-9 . _ - and '/' between parts";
+  std::string expected = "a mount point like \"/front\": '/' then A-Z a-z 0-9 . _ - and '/' between parts";
   if (mount.size() < 2 || mount.front() != '/' || mount.back() == '/') return expected;
   if (mount.find("//") != std::string_view::npos) return expected;
   for (const char c : mount) {

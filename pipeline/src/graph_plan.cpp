@@ -57,7 +57,7 @@ ElementSpec rtp_h264_payloader(const std::string& name) {
 }
 
 std::string with_index_pattern(const fs::path& file) {
-  const std::string s = file.string();
+  std::string s = file.string();
   if (s.find('%') != std::string::npos) return s;
   return (file.parent_path() / (file.stem().string() + "-%05d" + file.extension().string())).string();
 }

@@ -31,7 +31,7 @@ using test::TempFolder;
 namespace fs = std::filesystem;
 
 // Every element and URI scheme installed except those named.
-GstInventory inventory_without(std::set<std::string> elements, std::set<std::string> schemes = {}) {
+GstInventory inventory_without(const std::set<std::string>& elements, const std::set<std::string>& schemes = {}) {
   return GstInventory{[elements](const std::string& f) { return !elements.contains(f); },
                       [schemes](const std::string& s) { return !schemes.contains(s); }};
 }

@@ -257,8 +257,8 @@ TEST(EarlierFiles, TheNamesAPatternMakesAreFoundInIndexOrder) {
   }
   std::filesystem::create_directory(dir / "f_5.flo");
   const auto found = gst::files_matching((dir / "f_%d.flo").string());
-  std::vector<std::int64_t> indices;
-  for (const auto &f : found) indices.push_back(f.index);
+  std::vector<std::int64_t> indices(found.size());
+  std::transform(found.begin(), found.end(), indices.begin(), [](const auto &f) { return f.index; });
   // Not f_0100 (%d writes 100 as "100"), not f_-3 (indices start at 0).
   EXPECT_EQ(indices, (std::vector<std::int64_t>{9, 10}));
   EXPECT_EQ(found[0].bytes, 7u);
