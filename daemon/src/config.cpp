@@ -34,14 +34,22 @@ std::string summary(const std::vector<ConfigIssue>& issues) {
 
 }  // namespace
 
-std::string ConfigIssue::to_string() const {
-  std::string text = file.string();
-  if (line > 0) {
-    text += ':' + std::to_string(line);
-    if (column > 0) text += ':' + std::to_string(column);
+namespace {
+std::string position_text(const ConfigIssue& issue) {
+  std::string text = issue.file.string();
+  if (issue.line > 0) {
+    text += ':' + std::to_string(issue.line);
+    if (issue.column > 0) text += ':' + std::to_string(issue.column);
   }
-  return text + (is_warning() ? ": warning: " : ": ") + message;
+  return text;
 }
+}  // namespace
+
+std::string ConfigIssue::to_string() const {
+  return position_text(*this) + (is_warning() ? ": warning: " : ": ") + message;
+}
+
+std::string ConfigIssue::where_and_what() const { return position_text(*this) + ": " + message; }
 
 std::string ConfigIssue::source_excerpt() const {
   if (line <= 0) return {};

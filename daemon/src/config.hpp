@@ -114,6 +114,8 @@ struct ConfigIssue {
   Severity severity = Severity::error;
   bool is_warning() const { return severity == Severity::warning; }
   std::string to_string() const;  // "FILE:LINE:COLUMN: message", "FILE:LINE:COLUMN: warning: message"
+  // "FILE:LINE:COLUMN: message" whatever the severity, for a log line that states it already.
+  std::string where_and_what() const;
   // The line of the file it is about, indented, and a caret under the column; empty when the
   // issue has no line or the file cannot be read.
   std::string source_excerpt() const;

@@ -107,7 +107,8 @@ std::string Daemon::apply(Config next) {
   if (!log_level_override_.empty()) config_.daemon.log_level = log_level_override_;
   set_log_level(parse_log_level(config_.daemon.log_level));
   // What this machine lacks now; the streams concerned retry until it is there.
-  for (const ConfigIssue& warning : config_.warnings) log_warning(warning.to_string());
+  // The log line says "warning" itself.
+  for (const ConfigIssue& warning : config_.warnings) log_warning(warning.where_and_what());
 
   std::map<std::string, const StreamConfig*> wanted;
   for (const StreamConfig& s : config_.streams) wanted[s.name] = &s;

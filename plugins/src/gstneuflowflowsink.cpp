@@ -15,7 +15,12 @@ struct GstNeuflowFlowSinkPrivate {
   guint64 flows_written;
   guint64 bytes_written;
   guint64 buffers_skipped;
+  gboolean warned_no_flow;  // the no-flow warning was posted this run
 };
+
+// Buffers without flow are normal at the start of a stream and after a flush or a size change
+// (one each); this many with no flow at all means nothing upstream computes flow.
+constexpr guint64 kBuffersBeforeNoFlowWarning = 3;
 
 G_DEFINE_ABSTRACT_TYPE_WITH_CODE(GstNeuflowFlowSink, gst_neuflow_flow_sink, GST_TYPE_BASE_SINK,
                                  G_ADD_PRIVATE(GstNeuflowFlowSink)
@@ -55,6 +60,7 @@ static GstStateChangeReturn gst_neuflow_flow_sink_change_state(GstElement *eleme
     priv->flows_written = 0;
     priv->bytes_written = 0;
     priv->buffers_skipped = 0;
+    priv->warned_no_flow = FALSE;
     GST_OBJECT_UNLOCK(self);
     if (!klass->start_writing(self)) {
       klass->stop_writing(self);
@@ -86,8 +92,22 @@ static GstFlowReturn gst_neuflow_flow_sink_render(GstBaseSink *sink, GstBuffer *
   if (!meta || meta->width == 0 || meta->height == 0) {
     GST_OBJECT_LOCK(self);
     ++priv->buffers_skipped;
+    const bool warn =
+        !priv->warned_no_flow && priv->flows_written == 0 && priv->buffers_skipped == kBuffersBeforeNoFlowWarning;
+    if (warn) priv->warned_no_flow = TRUE;
     GST_OBJECT_UNLOCK(self);
     GST_LOG_OBJECT(self, "buffer %" GST_TIME_FORMAT " has no flow: skipped", GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
+    if (warn) {
+      const gchar *factory = GST_OBJECT_NAME(gst_element_get_factory(GST_ELEMENT(self)));
+      GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                          ("Nothing to write: the first %" G_GUINT64_FORMAT
+                           " buffers carry no optical flow. Is a neuflow element upstream? "
+                           "(… ! neuflow model=neuflow_mixed.pth ! %s …)",
+                           kBuffersBeforeNoFlowWarning, factory),
+                          ("%s writes the NeuflowFlowMeta the neuflow element attaches; buffers without it are "
+                           "skipped (see buffers-skipped)",
+                           factory));
+    }
     return GST_FLOW_OK;
   }
 

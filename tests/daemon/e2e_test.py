@@ -607,7 +607,10 @@ class CheckConfig(DaemonTestCase):
         self.assertIn("1 warning", out.stdout)
         d = self.start(text)
         d.wait_ready(60)
-        d.wait_log(r"warning: model: .*late\.pth", timeout=10)
+        d.wait_log(r"warning: .*:\d+:\d+: model: .*late\.pth", timeout=10)
+        # Said once: the log's level, not the config issue's again.
+        late = next(line for line in d.log_text().splitlines() if "late.pth" in line and "model:" in line)
+        self.assertEqual(late.count("warning"), 1, late)
         d.wait_log(r"stream late: .*restarting in", timeout=60)
         # The model arrives (fetch-model, a copy): the stream comes up by itself.
         os.makedirs(os.path.dirname(model))

@@ -108,6 +108,47 @@ TEST(NeuflowSink, PropertiesHaveTheirDocumentedDefaults) {
   g_free(index_location);
 }
 
+// The warnings the sink posted on its bus, their texts.
+std::vector<std::string> warnings(GstBus *bus) {
+  std::vector<std::string> texts;
+  while (GstMessage *m = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING)) {
+    GError *error = nullptr;
+    gst_message_parse_warning(m, &error, nullptr);
+    texts.emplace_back(error ? error->message : "");
+    if (error) g_error_free(error);
+    gst_message_unref(m);
+  }
+  return texts;
+}
+
+// A pipeline without a neuflow element upstream would otherwise write nothing and say nothing.
+TEST(NeuflowSink, WarnsOnceWhenNoBufferCarriesFlow) {
+  TempDir dir;
+  auto s = start_sink({{"location", (dir / "flow_%03d.flo").string()}});
+  ASSERT_TRUE(s.harness);
+  for (int i = 0; i < 8; ++i) ASSERT_EQ(gst_harness_push(s.harness.get(), gst_buffer_new()), GST_FLOW_OK);
+  const auto texts = warnings(s.bus.get());
+  ASSERT_EQ(texts.size(), 1u);
+  EXPECT_NE(texts[0].find("Is a neuflow element upstream?"), std::string::npos) << texts[0];
+  EXPECT_NE(texts[0].find("! neuflowsink"), std::string::npos) << texts[0];
+  EXPECT_EQ(uint64_property(s.element.get(), "buffers-skipped"), 8u);
+}
+
+// The first buffer of a stream (and of each flush) has no flow: no warning for that.
+TEST(NeuflowSink, AStreamWhoseFirstFrameHasNoFlowIsNotWarnedAbout) {
+  TempDir dir;
+  auto s = start_sink({{"location", (dir / "flow_%03d.flo").string()}});
+  ASSERT_TRUE(s.harness);
+  ASSERT_EQ(gst_harness_push(s.harness.get(), gst_buffer_new()), GST_FLOW_OK);
+  for (int n = 0; n < 4; ++n)
+    ASSERT_EQ(gst_harness_push(s.harness.get(),
+                               buffer_with_flow(FlowSpec{8, 6, static_cast<guint64>(n), static_cast<guint64>(n) + 1, 0,
+                                                         33333333, 0.5f * n})),
+              GST_FLOW_OK);
+  for (int i = 0; i < 4; ++i) ASSERT_EQ(gst_harness_push(s.harness.get(), gst_buffer_new()), GST_FLOW_OK);
+  EXPECT_TRUE(warnings(s.bus.get()).empty());
+}
+
 TEST(NeuflowSink, WritesNumberedFilesWithTheSameVectorsAndAnIndexRowEach) {
   TempDir dir;
   auto s = start_sink({{"location", (dir / "flow_%03d.flo").string()}, {"index", "5"}});
