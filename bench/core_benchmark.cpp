@@ -301,10 +301,9 @@ void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant 
 std::string stage_group(const std::string& name) {
   namespace stage = neuflow::model::stage;
   for (const std::string_view scale : {stage::scale_s8, stage::scale_s16}) {
-    // An iteration's stages, by the prefix its names share: refine_s8_iter…, corr_s8_iter….
-    const std::string refine = stage::refine_iteration(scale, 0), corr = stage::corr_iteration(scale, 0);
-    const auto prefix = [](const std::string& s) { return s.substr(0, s.size() - 1); };  // less the "0"
-    if (name.starts_with(prefix(refine)) || name.starts_with(prefix(corr))) return "refine_" + std::string(scale);
+    if (name.starts_with(stage::refine_prefix(scale)) || name.starts_with(stage::corr_prefix(scale))) {
+      return "refine_" + std::string(scale);
+    }
   }
   if (name == stage::backbone_s16 || name == stage::backbone_s8 || name == stage::conv_s8) return "encode";
   if (name == stage::merge_s8 || name == stage::context_merge_s8) return std::string(stage::merge_s8);

@@ -24,17 +24,6 @@ struct NamePattern {
   int base = 10;
 };
 
-// What the sink names file `index` (gstneuflowsink.cpp formats it the same way).
-std::string format_name(const std::string& pattern, int index) {
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-  gchar* name = g_strdup_printf(pattern.c_str(), index);
-#pragma GCC diagnostic pop
-  std::string out(name);
-  g_free(name);
-  return out;
-}
-
 std::string unescape_percent(std::string_view text) {
   std::string out;
   for (std::size_t i = 0; i < text.size(); ++i) {
@@ -93,7 +82,7 @@ std::optional<std::int64_t> index_in(const std::string& name, const NamePattern&
   }
   const long long index = std::stoll(digits, nullptr, p.base);
   if (index > std::numeric_limits<int>::max()) return std::nullopt;
-  if (format_name(p.pattern, static_cast<int>(index)) != name) return std::nullopt;
+  if (format_index_name(p.pattern, static_cast<int>(index)) != name) return std::nullopt;
   return index;
 }
 
@@ -110,6 +99,16 @@ std::optional<std::string> temporary_target(const std::string& name) {
 fs::path folder_of(const fs::path& path) { return path.parent_path().empty() ? fs::path(".") : path.parent_path(); }
 
 }  // namespace
+
+std::string format_index_name(const std::string& pattern, int index) {
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+  gchar* name = g_strdup_printf(pattern.c_str(), index);
+#pragma GCC diagnostic pop
+  std::string out(name);
+  g_free(name);
+  return out;
+}
 
 std::vector<EarlierFile> files_matching(const std::string& pattern) {
   const fs::path path(pattern);

@@ -1,12 +1,17 @@
 #pragma once
 // What earlier runs of a neuflowsink left in its folder: the flow files its location pattern
 // names (so max-files / max-bytes count them too, after a restart or a reload), and the hidden
-// temporaries of writes that a crash or kill -9 interrupted. No GStreamer in here.
+// temporaries of writes that a crash or kill -9 interrupted. No GStreamer in here (GLib formats
+// the names).
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace neuflow::gst {
+
+// The file name `pattern` (one integer conversion, checked by the sink) gives file `index`: how
+// the sink names what it writes, and what retention matches names against.
+std::string format_index_name(const std::string& pattern, int index);
 
 struct EarlierFile {
   std::string path;

@@ -269,10 +269,15 @@ double FlowEngine::announced_latency() const {
 void FlowEngine::inference_loop(gpointer engine) { static_cast<FlowEngine*>(engine)->inference_step(); }
 void FlowEngine::push_loop(gpointer engine) { static_cast<FlowEngine*>(engine)->push_step(); }
 
-void FlowEngine::error(GQuark domain, gint code, const std::string& text, const std::string& debug) {
+void FlowEngine::post(GstMessageType type, GQuark domain, gint code, const std::string& text,
+                      const std::string& debug) {
   // No text: GStreamer's own wording for the code, as GST_ELEMENT_ERROR(…, (nullptr), …) gives.
-  gst_element_message_full(element_, GST_MESSAGE_ERROR, domain, code, text.empty() ? nullptr : g_strdup(text.c_str()),
+  gst_element_message_full(element_, type, domain, code, text.empty() ? nullptr : g_strdup(text.c_str()),
                            debug.empty() ? nullptr : g_strdup(debug.c_str()), __FILE__, GST_FUNCTION, __LINE__);
+}
+
+void FlowEngine::error(GQuark domain, gint code, const std::string& text, const std::string& debug) {
+  post(GST_MESSAGE_ERROR, domain, code, text, debug);
 }
 
 void FlowEngine::post_stats(const FlowStats& s) {
@@ -390,8 +395,7 @@ GstFlowReturn FlowEngine::deliver_oldest(const Settings& settings) {
 
 void FlowEngine::post_running_on_change() {
   reported_fallback_ = session_->fallback_warning();
-  gst_element_message_full(element_, GST_MESSAGE_WARNING, GST_RESOURCE_ERROR, GST_RESOURCE_ERROR_FAILED,
-                           g_strdup(reported_fallback_.c_str()), nullptr, __FILE__, GST_FUNCTION, __LINE__);
+  post(GST_MESSAGE_WARNING, GST_RESOURCE_ERROR, GST_RESOURCE_ERROR_FAILED, reported_fallback_);
   const std::lock_guard lock(lock_);
   running_on_ = session_->backend_description();
 }

@@ -129,6 +129,7 @@ class FlowEngine {
   GstFlowReturn submit_frame(GstBuffer* buffer, guint64 frame_number);
   GstFlowReturn deliver_oldest(const Settings& settings);
   void discard_in_flight();
+  void post(GstMessageType type, GQuark domain, gint code, const std::string& text, const std::string& debug = {});
   void error(GQuark domain, gint code, const std::string& text, const std::string& debug = {});
   void post_stats(const FlowStats& s);
   void post_drop(GstBuffer* dropped, const GstSegment& segment, guint64 processed, guint64 drops);

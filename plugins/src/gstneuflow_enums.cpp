@@ -42,26 +42,17 @@ const GEnumValue kBehaviours[] = {
           behaviour_name(Behaviour::every_pair)),
     kEnd};
 
-GType register_enum(GType &type, const char *name, const GEnumValue *values) {
-  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static(name, values));
+// One GType per values table, registered on first use.
+template <const GEnumValue *Values>
+GType enum_type(const char *name) {
+  static GType type = 0;
+  if (g_once_init_enter(&type)) g_once_init_leave(&type, g_enum_register_static(name, Values));
   return type;
 }
 
 }  // namespace
 
-GType gst_neuflow_channel_order_get_type() {
-  static GType type = 0;
-  return register_enum(type, "GstNeuflowChannelOrder", kChannelOrders);
-}
-GType gst_neuflow_backend_get_type() {
-  static GType type = 0;
-  return register_enum(type, "GstNeuflowBackend", kBackends);
-}
-GType gst_neuflow_precision_get_type() {
-  static GType type = 0;
-  return register_enum(type, "GstNeuflowPrecision", kPrecisions);
-}
-GType gst_neuflow_behaviour_get_type() {
-  static GType type = 0;
-  return register_enum(type, "GstNeuflowBehaviour", kBehaviours);
-}
+GType gst_neuflow_channel_order_get_type() { return enum_type<kChannelOrders>("GstNeuflowChannelOrder"); }
+GType gst_neuflow_backend_get_type() { return enum_type<kBackends>("GstNeuflowBackend"); }
+GType gst_neuflow_precision_get_type() { return enum_type<kPrecisions>("GstNeuflowPrecision"); }
+GType gst_neuflow_behaviour_get_type() { return enum_type<kBehaviours>("GstNeuflowBehaviour"); }

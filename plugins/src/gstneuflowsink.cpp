@@ -151,18 +151,6 @@ std::optional<std::string> check_location_pattern(const char *pattern) {
   return std::nullopt;
 }
 
-// The file name for `index`; `pattern` has passed check_location_pattern, which makes the
-// non-literal format safe: one int argument for one integer conversion.
-std::string format_location(const char *pattern, gint index) {
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-  gchar *name = g_strdup_printf(pattern, index);
-#pragma GCC diagnostic pop
-  std::string out(name);
-  g_free(name);
-  return out;
-}
-
 // A timestamp for the index: none when it is not known.
 std::optional<std::int64_t> index_time(GstClockTime t) {
   return GST_CLOCK_TIME_IS_VALID(t) ? std::optional<std::int64_t>(static_cast<std::int64_t>(t)) : std::nullopt;
@@ -288,7 +276,7 @@ static gboolean gst_neuflow_sink_start_writing(GstNeuflowFlowSink *sink) {
                       (nullptr));
     return FALSE;
   }
-  if (!neuflow::flow::flow_format_from_path(format_location(location, index))) {
+  if (!neuflow::flow::flow_format_from_path(neuflow::gst::format_index_name(location, index))) {
     GST_ELEMENT_ERROR(self, RESOURCE, SETTINGS,
                       ("Invalid flow file location \"%s\": the extension must be .flo, .npy or .png.", location),
                       (nullptr));
@@ -463,7 +451,7 @@ static GstFlowReturn gst_neuflow_sink_write_flow(GstNeuflowFlowSink *sink, GstBu
   GST_OBJECT_LOCK(self);
   const gint index = self->index;
   GST_OBJECT_UNLOCK(self);
-  const std::string path = format_location(self->pattern, index);
+  const std::string path = neuflow::gst::format_index_name(self->pattern, index);
 
   try {
     neuflow::flow::FlowField field(static_cast<int>(meta->width), static_cast<int>(meta->height));

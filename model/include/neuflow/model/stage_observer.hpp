@@ -35,12 +35,11 @@ inline constexpr std::string_view scale_s8 = "s8";
 
 // A refinement iteration ("refine_s8_iter3"), its correlation ("corr_s8_iter3") and its
 // outputs ("refine_s8_iter3_hidden", "refine_s8_iter3_delta").
-inline std::string refine_iteration(std::string_view scale, int i) {
-  return "refine_" + std::string(scale) + "_iter" + std::to_string(i);
-}
-inline std::string corr_iteration(std::string_view scale, int i) {
-  return "corr_" + std::string(scale) + "_iter" + std::to_string(i);
-}
+// What every iteration's names at a scale begin with ("refine_s8_iter", "corr_s8_iter").
+inline std::string refine_prefix(std::string_view scale) { return "refine_" + std::string(scale) + "_iter"; }
+inline std::string corr_prefix(std::string_view scale) { return "corr_" + std::string(scale) + "_iter"; }
+inline std::string refine_iteration(std::string_view scale, int i) { return refine_prefix(scale) + std::to_string(i); }
+inline std::string corr_iteration(std::string_view scale, int i) { return corr_prefix(scale) + std::to_string(i); }
 }  // namespace stage
 
 // How long a stage ran on the device, from the GPU's own timestamps (FlowSession::
