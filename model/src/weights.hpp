@@ -83,6 +83,12 @@ struct BasicNetworkWeights {
   BasicConvWeights<T> upsample_conv1, upsample_conv2, upsample_conv3;
 };
 
+// A tensor's place in one packed buffer (a GPU backend's weights): its offset in elements, or
+// -1 where the host had none (a layer without bias).
+struct PackedTensor {
+  int offset = -1;
+};
+
 using ConvWeights = BasicConvWeights<std::vector<float>>;
 using LinearWeights = BasicLinearWeights<std::vector<float>>;
 using LayerNormWeights = BasicLayerNormWeights<std::vector<float>>;

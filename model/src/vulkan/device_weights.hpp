@@ -11,11 +11,8 @@
 
 namespace neuflow::model::vulkan {
 
-// A tensor in the weights' buffer: its offset in elements, or -1 where the host had none (a
-// layer without bias).
-struct DeviceTensor {
-  int offset = -1;
-};
+// A tensor in the weights' buffer.
+using DeviceTensor = PackedTensor;
 
 using DeviceConv = BasicConvWeights<DeviceTensor>;  // weight: OIHW, read as a row-major [out][in·k·k]
 using DeviceLinear = BasicLinearWeights<DeviceTensor>;

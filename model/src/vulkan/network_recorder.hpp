@@ -1,7 +1,7 @@
 #pragma once
-// What the two halves of VulkanNetwork share (vulkan_network.cpp: buffers, the ring, recorded
-// passes; vulkan_network_record.cpp: the network as dispatches): the dispatch-size rules and
-// the Recorder that writes one pass into a command buffer.
+// What VulkanNetwork (buffers, the ring, recorded passes) and the ops that record the graph
+// (ops/) share: the dispatch-size rules and the Recorder that writes one pass into a command
+// buffer.
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -9,19 +9,27 @@
 #include <string_view>
 #include <vector>
 
-#include "network_dims.hpp"
+#include "graph/activation.hpp"
+#include "graph/tensors.hpp"
 #include "vulkan/vulkan_network.hpp"
 
 namespace neuflow::model::vulkan {
 
-inline constexpr int kDim = kFeatureChannels;  // attention tokens' width
 // The attention's and matching's score blocks hold at most this many floats (32 MiB), well
 // inside lavapipe's 128 MiB per buffer, so memory stays O(L · block) at any size.
 inline constexpr int kScoreBlockFloats = 8 << 20;
 inline constexpr int kLocal = 256;  // invocations per workgroup of the element-wise shaders
 
-// An activation code of shaders/params/activation.h.
-using Act = int;
+// The activation's code in shaders/params/activation.h.
+inline int activation_code(Activation act) {
+  switch (act) {
+    case Activation::none: return kActNone;
+    case Activation::leaky_relu: return kActLeakyRelu;
+    case Activation::relu: return kActRelu;
+    case Activation::gelu: return kActGelu;
+  }
+  return kActNone;
+}
 
 // Element-wise shaders loop over what a capped dispatch does not cover (common.glsl).
 inline uint32_t groups(long count, long per_group) {
@@ -150,60 +158,32 @@ class VulkanNetwork::Recorder {
     vkCmdCopyBuffer(commands_, net_.zeros_.handle(), dst.buffer->handle(), 1, &region);
   }
 
-  // out = act(conv(in) + bias (+ addend)); out.c must be the layer's output channels.
-  void conv(const DeviceConv& w, const View& in, int stride, int pad, Act act, const View& out,
-            const View* addend = nullptr) {
-    const Conv2dParams p{in.c,
-                         in.h,
-                         in.w,
-                         in.offset(),
-                         out.c,
-                         out.h,
-                         out.w,
-                         out.offset(),
-                         w.kernel_h,
-                         stride,
-                         pad,
-                         act,
-                         w.weight.offset,
-                         w.bias.offset,
-                         addend ? addend->offset() : -1,
-                         1.f};
-    dispatch<Shader::conv2d>({&net_.weights_->buffer, in.buffer, out.buffer, addend ? addend->buffer : nullptr}, p,
-                             tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
-  }
-
-  // Token lists [features][tokens]: out = act(W · in + b).
-  void linear(const DeviceLinear& w, const Buffer& in, int in_off, const Buffer& out, int out_off, int tokens,
-              Act act = kActNone) {
-    const MatmulParams p{w.out_features,  tokens,        w.in_features,
-                         w.weight.offset, w.in_features, 1,
-                         in_off,          tokens,        1,
-                         out_off,         tokens,        1,
-                         w.bias.offset,   act,           1.f};
-    dispatch<Shader::matmul>({&net_.weights_->buffer, &in, &out, nullptr}, p, tiles(tokens, "attention"),
-                             tiles(w.out_features, "attention"));
-  }
-
   void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulParams& p) {
     dispatch<Shader::matmul>({&a, &b, &c, nullptr}, p, tiles(p.n, "attention"), tiles(p.m, "attention"));
   }
 
-  void resample(const View& src, const View& dst, int factor, bool relu, float scale) {
-    const ResampleParams p{src.c, src.h, src.w, src.offset(), dst.offset(), factor, relu ? 1 : 0, scale};
-    dispatch<Shader::resample>({src.buffer, nullptr, dst.buffer, nullptr}, p,
-                               groups(static_cast<long>(dst.count()), kLocal));
-  }
+  // The pass's frames: the slot that holds the frame each graph::FrameRole names (-1: none).
+  void bind_frames(std::array<int, 3> slots) { frames_ = slots; }
+  // An encode pass's source: an 8-bit frame in the upload (its layout), or nullptr for floats.
+  void set_frame_layout(const FrameLayout* layout) { frame_layout_ = layout; }
+  const FrameLayout* frame_layout() const { return frame_layout_; }
 
-  void avgpool(const View& src, const View& dst) {
-    const Avgpool2xParams p{src.c, src.h, src.w};
-    dispatch<Shader::avgpool2x>({src.buffer, nullptr, dst.buffer, nullptr}, p,
-                                groups(static_cast<long>(dst.count()), kLocal));
+  // A slice of the graph's tensors in this pass's memory.
+  View view(const graph::Slice& s) const {
+    const graph::TensorDesc& d = net_.graph_.tensors.at(s.tensor);
+    return {&net_.buffer_of(s.tensor, frames_), s.channel, s.c, d.h, d.w};
   }
+  const Buffer& weights() const { return net_.weights_->buffer; }
+  int height() const { return net_.height_; }
+  int width() const { return net_.width_; }
 
-  void axpby(float a, const View& x, float b, const View& y, const View& out) {
-    const AxpbyParams p{out.count(), x.offset(), y.offset(), out.offset(), a, b};
-    dispatch<Shader::axpby>({x.buffer, y.buffer, out.buffer, nullptr}, p, groups(out.count(), kLocal));
+  // Copies `v` to the start of the ring entry's read-back buffer, for the host once the pass ends.
+  void read_back(const View& v) {
+    barrier();
+    const VkDeviceSize e = net_.elem_;
+    const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
+    vkCmdCopyBuffer(commands_, v.buffer->handle(), transfer_.readback.handle(), 1, &region);
+    host_barrier();
   }
 
   // Reads `v` back and hands it to the observer as NHWC (only when observing).
@@ -212,11 +192,7 @@ class VulkanNetwork::Recorder {
       mark(name);
       return;
     }
-    barrier();
-    const VkDeviceSize e = net_.elem_;
-    const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
-    vkCmdCopyBuffer(commands_, v.buffer->handle(), transfer_.readback.handle(), 1, &region);
-    host_barrier();
+    read_back(v);
     run();
     net_.staging_.resize(static_cast<std::size_t>(v.count()));
     net_.load(transfer_.readback.mapped(), net_.staging_.size(), net_.staging_.data());
@@ -240,6 +216,8 @@ class VulkanNetwork::Recorder {
   const Transfer& transfer_;
   uint32_t query_base_;
   bool worked_ = false;  // commands recorded since the last timestamp
+  std::array<int, 3> frames_{-1, -1, -1};
+  const FrameLayout* frame_layout_ = nullptr;
   std::vector<float> nhwc_;
 };
 

@@ -19,74 +19,13 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
       elem_(fp16_ ? 2 : 4),
       height_(height),
       width_(width),
-      h8_(height / 8),
-      w8_(width / 8),
-      h16_(height / 16),
-      w16_(width / 16),
-      tokens_(h16_ * w16_) {
+      tokens_((height / 16) * (width / 16)) {
   block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
-  const std::size_t hw = static_cast<std::size_t>(height) * width, hw8 = static_cast<std::size_t>(h8_) * w8_;
-  const std::size_t l = tokens_;
-  using M = VulkanDevice::Memory;
-  const auto make = [&](std::size_t values, const char* what, M memory = M::device) {
-    return device_.create_buffer(values * elem_, memory,
-                                 std::string(what) + " at " + std::to_string(width) + "x" + std::to_string(height));
-  };
-  dummy_ = make(4, "a placeholder binding");
-  zeros_ = make(kHiddenChannels * hw8 + 2, "zeros");
-  for (std::size_t e = 0; e < ring_.size(); ++e) {
-    ring_[e].upload = make(3 * hw, "the frame upload", M::upload);
-    // Entry 0 also serves the observer, which reads whole stages back.
-    ring_[e].readback =
-        make(e == 0 ? std::max(kFeatureChannels * hw8, 2 * hw) : 2 * hw, "the read-back buffer", M::readback);
-  }
-  input_ = make(3 * hw, "the input frame");
-  half_ = make(3 * hw / 4, "the 1/2 frame");
-  quarter_ = make(3 * hw / 16, "the 1/4 frame");
-  eighth_ = make(3 * hw / 64, "the 1/8 frame");
-  encode_tmp_ = make(256 * hw8, "the backbone's scratch");
-  cat8_ = make(384 * hw8, "the 1/8 concatenation");
-  cat16_ = make(256 * l, "the 1/16 concatenation");
-  for (auto& s : slots_) {
-    s.f8 = make(kFeatureChannels * hw8, "frame features at 1/8");
-    s.f16 = make(kFeatureChannels * l, "frame features at 1/16");
-    s.up = make(128 * hw8, "the upsampler's frame features");
-  }
-  q_ = make(kDim * l, "attention queries");
-  k_ = make(kDim * l, "attention keys");
-  v_ = make(kDim * l, "attention values");
-  scores_ = make(static_cast<std::size_t>(block_rows_) * l, "a block of attention scores");
-  message_ = make(kDim * l, "attention messages");
-  attn_tmp_ = make(kDim * l, "attention scratch");
-  mlp_in_ = make(2 * kDim * l, "the attention MLP's input");
-  mlp_hidden_ = make(2 * kDim * l, "the attention MLP's hidden layer");
-  state0_ = make(kDim * l, "attention layer 0, frame 0");
-  state1_ = make(kDim * l, "attention layer 0, frame 1");
-  for (auto& a : attended_) a = make(kDim * l, "attention output");
-  grid_ = make(2 * l, "the matching grid");
-  correspondence_ = make(2 * l, "matching correspondences");
-  flow16_ = make(2 * l, "flow at 1/16");
-  flow8_ = make(2 * hw8, "flow at 1/8");
-  const auto make_refine = [&](Refine& r, std::size_t plane) {
-    r.input = make(kRefineDynamicChannels * plane, "the refinement input");
-    r.constant_in = make(kRefineConstantChannels * plane, "the refinement's constant input");
-    r.constant_out = make(kRefineHiddenWidth * plane, "the refinement's constant part");
-    r.xa = make(kRefineHiddenWidth * plane, "refinement scratch");
-    r.xb = make(kRefineHiddenWidth * plane, "refinement scratch");
-    r.out66 = make(kRefineOutputChannels * plane, "the refinement output");
-  };
-  make_refine(refine16_, l);
-  make_refine(refine8_, hw8);
-  feature_in_ = make(2 * kMatchingChannels * hw8, "the 1/8 feature merge input");
-  merge_tmp_ = make(kMatchingChannels * hw8, "merge scratch");
-  context_in_ = make(2 * kContextChannels * hw8, "the context merge input");
-  context_tmp_ = make(kContextChannels * hw8, "context merge scratch");
-  for (auto& f : features8_) f = make(kMatchingChannels * hw8, "merged features at 1/8");
-  upsample_in_ = make(130 * hw8, "the upsampler input");
-  upsample1_ = make(256 * hw8, "the upsampler's first layer");
-  upsample2_ = make(512 * hw8, "the upsampler's second layer");
-  mask_ = make(kUpsampleMaskChannels * hw8, "the upsampling mask");
-  flow_full_ = make(2 * hw, "the full-resolution flow");
+  graph_ = graph::build_network_graph<DeviceTensor>(*weights_, height, width, kPlanIterations, block_rows_);
+  graph::check_shapes(graph_);
+  plan_ = graph::plan_memory(graph_.tensors,
+                             graph::live_ranges<DeviceTensor>(graph_.tensors, {&graph_.encode, &graph_.flow}));
+  allocate_tensors();
 
   // The buffers release themselves; the pool and fence are released here if setting up fails.
   try {
@@ -128,39 +67,6 @@ void VulkanNetwork::release_handles() {
   timestamps_ = VK_NULL_HANDLE;
   pool_ = VK_NULL_HANDLE;
   descriptor_pools_.clear();
-}
-
-// What no pass writes: the position channels of f16, the matching grid, the radius planes.
-void VulkanNetwork::initialise_constants() {
-  const std::size_t l = tokens_, hw8 = static_cast<std::size_t>(h8_) * w8_;
-  // Positions (2·L), the grid (2·L), then radius planes (as many as the larger plane).
-  std::vector<float> c(4 * l + hw8, kCorrRadiusPlane);
-  for (int y = 0; y < h16_; ++y) {
-    for (int x = 0; x < w16_; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y) * w16_ + x;
-      c[p] = static_cast<float>(y) - static_cast<float>(h16_) / 2.f;      // f16 position channel y
-      c[l + p] = static_cast<float>(x) - static_cast<float>(w16_) / 2.f;  // f16 position channel x
-      c[2 * l + p] = static_cast<float>(x);                               // grid x
-      c[3 * l + p] = static_cast<float>(y);                               // grid y
-    }
-  }
-  Buffer staging = device_.create_buffer(c.size() * elem_, VulkanDevice::Memory::upload, "constants");
-  store(c.data(), c.size(), staging.mapped());
-  const VkDeviceSize e = elem_;
-  OneShotCommands commands(device_);
-  VkCommandBuffer cb = commands.buffer();
-  for (auto& s : slots_) {
-    const VkBufferCopy pos{0, kBackbone16Channels * l * e, 2 * l * e};
-    vkCmdCopyBuffer(cb, staging.handle(), s.f16.handle(), 1, &pos);
-  }
-  const VkBufferCopy grid{2 * l * e, 0, 2 * l * e};
-  vkCmdCopyBuffer(cb, staging.handle(), grid_.handle(), 1, &grid);
-  const VkBufferCopy radius16{4 * l * e, kContextChannels * l * e, l * e},
-      radius8{4 * l * e, kContextChannels * hw8 * e, hw8 * e};
-  vkCmdCopyBuffer(cb, staging.handle(), refine16_.constant_in.handle(), 1, &radius16);
-  vkCmdCopyBuffer(cb, staging.handle(), refine8_.constant_in.handle(), 1, &radius8);
-  vkCmdFillBuffer(cb, zeros_.handle(), 0, VK_WHOLE_SIZE, 0);
-  commands.run();
 }
 
 void VulkanNetwork::store(const float* values, std::size_t count, void* device_memory) const {
@@ -344,10 +250,6 @@ void VulkanNetwork::flow(int slot0, int slot1, const Iterations& iterations, Ten
     run(cached(key, 0, [&](Recorder& r) { record_flow(r, slot0, slot1, iterations); }));
   }
   read_flow(ring_[0], out);
-  if (observer && *observer) {
-    const std::string name(stage::flow);
-    (*observer)(StageTensor{name, 0, height_, width_, 2, out.data.data()});
-  }
 }
 
 void VulkanNetwork::start(const Step& step) {

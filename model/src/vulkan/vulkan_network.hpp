@@ -1,8 +1,9 @@
 #pragma once
-// The whole forward pass on a Vulkan device at one model resolution: every buffer, descriptor
-// set and command buffer is created once here; a pass replays a command buffer recorded the
-// first time that pass (encode into a slot, or flow between two slots with given iterations)
-// was asked for. With an observer the pass is recorded anew, stopping at every named stage to
+// The whole forward pass on a Vulkan device at one model resolution: the network graph's ops
+// recorded into command buffers (ops/: one file per op), its tensors in buffers planned from
+// their live ranges. Every buffer, descriptor set and command buffer is created once here; a
+// pass replays a command buffer recorded the first time that pass (encode into a slot, or flow
+// between two slots with given iterations) was asked for. With an observer the pass is recorded anew, stopping at every named stage to
 // read it back. Without one, a recorded pass writes a GPU timestamp after each named stage
 // (where the queue has timestamps), so every pass also measures where its time went.
 //
@@ -22,6 +23,8 @@
 #include <utility>
 #include <vector>
 
+#include "graph/memory_plan.hpp"
+#include "graph/network_graph.hpp"
 #include "inference_backend.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
@@ -94,12 +97,6 @@ class VulkanNetwork {
   class Recorder;
 
  private:
-  struct Slot {
-    Buffer f8, f16, up;
-  };
-  struct Refine {
-    Buffer input, constant_in, constant_out, xa, xb, out66;
-  };
   // A recorded pass: the stage after which each of its timestamps 1.. is written (0: its start),
   // in the query range of the ring entry it was recorded for.
   struct Pass {
@@ -122,10 +119,12 @@ class VulkanNetwork {
   // frame: the upload holds an 8-bit frame; nullptr: the upload holds the input as floats.
   void record_encode(Recorder& r, int slot, const FrameLayout* frame);
   void record_flow(Recorder& r, int slot0, int slot1, const Iterations& iterations);
-  void record_attention_layer(Recorder& r, const DeviceAttentionLayer& w, const Buffer& src, const Buffer& tgt,
-                              const Buffer& out);
-  void record_refinement(Recorder& r, const DeviceRefine& w, Refine& buffers, const View& f0, const View& f1,
-                         const View& flow, int iterations, std::string_view scale);
+  void record(Recorder& r, const graph::OpList<DeviceTensor>& ops);
+  // The flow ops for these iterations, checked once against the memory plan.
+  const graph::OpList<DeviceTensor>& flow_ops(const Iterations& iterations);
+  // `frames`: the slot of each graph::FrameRole in the pass.
+  const Buffer& buffer_of(graph::TensorId tensor, const std::array<int, 3>& frames) const;
+  void allocate_tensors();
   // entry: the ring entry whose buffers and timestamps the pass uses.
   const Pass& cached(const std::string& key, int entry, const std::function<void(Recorder&)>& record);
   void run(const Pass& pass);
@@ -145,22 +144,22 @@ class VulkanNetwork {
   VulkanDevice& device_;
   bool fp16_;         // tensors stored as float16_t
   std::size_t elem_;  // bytes per stored value: 4 or 2
-  int height_, width_, h8_, w8_, h16_, w16_, tokens_, block_rows_;
+  int height_, width_, tokens_, block_rows_;
 
   Buffer dummy_, zeros_;
   std::array<Transfer, kRing> ring_;
   int next_entry_ = 0;
   std::deque<Started> started_;
   std::vector<float> staging_;  // host-side frame or read-back, as floats
-  Buffer input_, half_, quarter_, eighth_, encode_tmp_, cat8_, cat16_;
-  std::array<Slot, kSlots> slots_;
-  Buffer q_, k_, v_, scores_, message_, attn_tmp_, mlp_in_, mlp_hidden_, state0_, state1_;
-  std::array<Buffer, 2> attended_;
-  Buffer grid_, correspondence_, flow16_, flow8_;
-  Refine refine16_, refine8_;
-  Buffer feature_in_, merge_tmp_, context_in_, context_tmp_;
-  std::array<Buffer, 2> features8_;
-  Buffer upsample_in_, upsample1_, upsample2_, mask_, flow_full_;
+  // Planned with kPlanIterations; the flow ops of other iterations are built and checked
+  // against the plan when first asked for.
+  static constexpr Iterations kPlanIterations{2, 2};
+  graph::NetworkGraph<DeviceTensor> graph_;
+  graph::MemoryPlan plan_;
+  std::map<std::pair<int, int>, graph::OpList<DeviceTensor>> flow_ops_;
+  std::vector<Buffer> regions_;                               // the transient tensors'
+  std::map<graph::TensorId, Buffer> persistent_;              // by tensor
+  std::array<std::map<std::string, Buffer>, kSlots> frames_;  // each slot's frame tensors, by name
 
   VkCommandPool pool_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorPool> descriptor_pools_;

@@ -1,9 +1,9 @@
 #pragma once
 // What a convolution computes besides its weights: stride, padding, the fused activation.
 
-namespace neuflow::model {
+#include "graph/activation.hpp"
 
-enum class Activation { none, leaky_relu, relu, gelu };
+namespace neuflow::model {
 
 struct ConvParams {
   int stride = 1;

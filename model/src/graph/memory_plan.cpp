@@ -1,0 +1,139 @@
+#include "graph/memory_plan.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace neuflow::model::graph {
+
+namespace {
+
+bool planned(const TensorDesc& d) { return d.storage == Storage::transient; }
+
+bool meet(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) {
+  for (const LiveRange& x : a) {
+    for (const LiveRange& y : b) {
+      if (x.first <= y.last && y.first <= x.last) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+template <typename T>
+LiveRanges live_ranges(const TensorTable& tensors, const std::vector<const OpList<T>*>& passes) {
+  LiveRanges ranges(tensors.size());
+  std::vector<bool> open(tensors.size(), false);
+  int index = 0;
+  for (const OpList<T>* pass : passes) {
+    std::fill(open.begin(), open.end(), false);
+    for (const Op<T>& op : *pass) {
+      // Reads first: an op that reads and writes a tensor continues its range.
+      std::vector<TensorId> read;
+      std::visit(
+          [&](const auto& o) {
+            o.accesses([&](const Slice& s, Access a) {
+              if (a == Access::read) read.push_back(s.tensor);
+            });
+          },
+          op);
+      for (const TensorId t : read) {
+        const auto i = static_cast<std::size_t>(t);
+        if (!planned(tensors.at(t))) continue;
+        if (!open[i]) {
+          throw std::logic_error("the network graph reads " + tensors.at(t).name +
+                                 " before any op of its pass writes it");
+        }
+        ranges[i].back().last = index;
+      }
+      std::visit(
+          [&](const auto& o) {
+            o.accesses([&](const Slice& s, Access a) {
+              const auto i = static_cast<std::size_t>(s.tensor);
+              if (a != Access::write || !planned(tensors.at(s.tensor))) return;
+              const bool whole = s.channel == 0 && s.c == tensors.at(s.tensor).c;
+              const bool also_read = std::find(read.begin(), read.end(), s.tensor) != read.end();
+              if (!open[i] || (whole && !also_read)) {
+                ranges[i].push_back({index, index});
+                open[i] = true;
+              } else {
+                ranges[i].back().last = index;
+              }
+            });
+          },
+          op);
+      ++index;
+    }
+  }
+  return ranges;
+}
+
+template LiveRanges live_ranges(const TensorTable&, const std::vector<const OpList<std::vector<float>>*>&);
+template LiveRanges live_ranges(const TensorTable&, const std::vector<const OpList<PackedTensor>*>&);
+
+std::size_t MemoryPlan::planned_size() const {
+  return std::accumulate(region_size.begin(), region_size.end(), std::size_t{0});
+}
+
+MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges) {
+  MemoryPlan plan;
+  plan.region.assign(tensors.size(), -1);
+  std::vector<TensorId> order;
+  for (std::size_t t = 0; t < tensors.size(); ++t) {
+    if (!ranges[t].empty()) order.push_back(static_cast<TensorId>(t));
+  }
+  std::stable_sort(order.begin(), order.end(), [&](TensorId a, TensorId b) {
+    return ranges[static_cast<std::size_t>(a)].front().first < ranges[static_cast<std::size_t>(b)].front().first;
+  });
+  std::vector<std::vector<TensorId>> members;
+  for (const TensorId t : order) {
+    const std::size_t need = tensors.at(t).count();
+    int best = -1;
+    // Growth first (what choosing the region adds to the total), then the tightest fit.
+    std::size_t best_growth = std::numeric_limits<std::size_t>::max(), best_size = 0;
+    for (std::size_t r = 0; r < members.size(); ++r) {
+      const bool free = std::none_of(members[r].begin(), members[r].end(), [&](TensorId other) {
+        return meet(ranges[static_cast<std::size_t>(t)], ranges[static_cast<std::size_t>(other)]);
+      });
+      if (!free) continue;
+      const std::size_t size = plan.region_size[r];
+      const std::size_t growth = need > size ? need - size : 0;
+      if (growth < best_growth || (growth == best_growth && size < best_size)) {
+        best = static_cast<int>(r);
+        best_growth = growth;
+        best_size = size;
+      }
+    }
+    // A new region costs `need`; growing one by as much or more is no better.
+    if (best < 0 || best_growth >= need) {
+      best = static_cast<int>(members.size());
+      members.emplace_back();
+      plan.region_size.push_back(0);
+    }
+    members[static_cast<std::size_t>(best)].push_back(t);
+    plan.region_size[static_cast<std::size_t>(best)] = std::max(plan.region_size[static_cast<std::size_t>(best)], need);
+    plan.region[static_cast<std::size_t>(t)] = best;
+  }
+  return plan;
+}
+
+void check_plan(const TensorTable& tensors, const MemoryPlan& plan, const LiveRanges& ranges) {
+  for (std::size_t a = 0; a < tensors.size(); ++a) {
+    if (ranges[a].empty()) continue;
+    if (plan.region[a] < 0 || tensors.at(static_cast<TensorId>(a)).count() >
+                                  plan.region_size[static_cast<std::size_t>(plan.region[a])]) {
+      throw std::logic_error("the memory plan has no room for " + tensors.at(static_cast<TensorId>(a)).name);
+    }
+    for (std::size_t b = a + 1; b < tensors.size(); ++b) {
+      if (plan.region[a] == plan.region[b] && meet(ranges[a], ranges[b])) {
+        throw std::logic_error("the memory plan puts " + tensors.at(static_cast<TensorId>(a)).name + " and " +
+                               tensors.at(static_cast<TensorId>(b)).name + ", which are live at once, in one region");
+      }
+    }
+  }
+}
+
+}  // namespace neuflow::model::graph

@@ -1,0 +1,201 @@
+#pragma once
+// NeuFlow-V2's ops on the graph's tensors. Every backend implements each op once (cpu/ executes,
+// vulkan/ records); the network is written once, as a list of them (network_graph.hpp).
+//
+// Ops that carry weights are templates over what holds a weight tensor (weights.hpp): the host's
+// std::vector<float>, a GPU's PackedTensor. Each op lists the slices it reads and writes
+// (accesses()), from which the tensors' live ranges and so both backends' memory are planned.
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "graph/activation.hpp"
+#include "graph/tensors.hpp"
+#include "weights.hpp"
+
+namespace neuflow::model::graph {
+
+enum class Access { read, write };
+
+// The pass's input frame, as the network takes it: [3][H][W] in 0..1. Where it comes from (an
+// 8-bit frame, a converted image) is the backend's business.
+struct FrameInput {
+  Slice out;
+  template <typename F>
+  void accesses(F&& f) const { f(out, Access::write); }
+};
+
+// 2×2 average pooling.
+struct AvgPool2x {
+  Slice in, out;
+  template <typename F>
+  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+};
+
+// out = act(conv(in) + bias (+ addend)); `layer` is the architecture table's name.
+template <typename T>
+struct Conv2d {
+  const BasicConvWeights<T>* weights = nullptr;
+  std::string layer;
+  Slice in, out;
+  int stride = 1, pad = 1;
+  Activation act = Activation::none;
+  std::optional<Slice> addend;
+  template <typename F>
+  void accesses(F&& f) const {
+    f(in, Access::read);
+    if (addend) f(*addend, Access::read);
+    f(out, Access::write);
+  }
+};
+
+// Per token (pixel): out = act(W · in + b).
+template <typename T>
+struct Linear {
+  const BasicLinearWeights<T>* weights = nullptr;
+  std::string layer;
+  Slice in, out;
+  Activation act = Activation::none;
+  template <typename F>
+  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+};
+
+// Attention over all tokens: out[:, i] = Σ_j softmax_j(q[:, i] · k[:, j]) v[:, j] (the scale is
+// folded into q's projection). `scores` holds a block of `block_rows` rows of it at a time.
+struct Attention {
+  Slice q, k, v, out;
+  TensorId scores = -1;
+  int block_rows = 1;
+  template <typename F>
+  void accesses(F&& f) const {
+    f(q, Access::read); f(k, Access::read); f(v, Access::read);
+    f({scores, 0, 1}, Access::write);
+    f(out, Access::write);
+  }
+};
+
+// LayerNorm over each token's channels (+ residual afterwards).
+template <typename T>
+struct LayerNorm {
+  const BasicLayerNormWeights<T>* weights = nullptr;
+  std::string layer;
+  Slice in, out;
+  std::optional<Slice> residual;
+  template <typename F>
+  void accesses(F&& f) const {
+    f(in, Access::read);
+    if (residual) f(*residual, Access::read);
+    f(out, Access::write);
+  }
+};
+
+// In place: x = x · scale[c] + shift[c] (a folded BatchNorm).
+template <typename T>
+struct ChannelAffine {
+  const T* scale = nullptr;
+  const T* shift = nullptr;
+  std::string layer;
+  Slice inout;
+  template <typename F>
+  void accesses(F&& f) const { f(inout, Access::read); f(inout, Access::write); }
+};
+
+// Flow at 1/16 from all-pairs matching: softmax(f0 · f1ᵀ / √c) · grid - grid, in blocks of
+// `block_rows` rows of the score matrix.
+struct GlobalMatching {
+  Slice f0, f1, grid, out;
+  TensorId scores = -1, correspondence = -1;
+  int block_rows = 1;
+  template <typename F>
+  void accesses(F&& f) const {
+    f(f0, Access::read); f(f1, Access::read); f(grid, Access::read);
+    f({scores, 0, 1}, Access::write);
+    f({correspondence, 0, 2}, Access::write);
+    f(out, Access::write);
+  }
+};
+
+// Nearest-neighbour upsampling by `factor` (1: a copy), out = scale · (relu ? max(in, 0) : in).
+struct Resample {
+  Slice in, out;
+  int factor = 1;
+  bool relu = false;
+  float scale = 1.f;
+  template <typename F>
+  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+};
+
+struct Copy {
+  Slice in, out;
+  template <typename F>
+  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+};
+
+struct Zero {
+  Slice out;
+  template <typename F>
+  void accesses(F&& f) const { f(out, Access::write); }
+};
+
+// The 9×9 window of f0 · f1 around each pixel displaced by the flow, divided by √c.
+struct LocalCorrelation {
+  Slice f0, f1, flow, out;
+  template <typename F>
+  void accesses(F&& f) const {
+    f(f0, Access::read); f(f1, Access::read); f(flow, Access::read);
+    f(out, Access::write);
+  }
+};
+
+// The refinement's step from conv3's output [delta 2, hidden 64]: hidden = clamp(hidden, ±4),
+// flow += delta, the new flow also into flow_copy (the next step's input).
+struct RefineUpdate {
+  Slice update, hidden, flow_copy, flow;
+  template <typename F>
+  void accesses(F&& f) const {
+    f(update, Access::read); f(flow, Access::read);
+    f(hidden, Access::write); f(flow_copy, Access::write); f(flow, Access::write);
+  }
+};
+
+// Flow at 1/8 to full size: each output pixel a softmax-weighted 3×3 neighbourhood (the 576
+// mask channels), times 8.
+struct ConvexUpsample {
+  Slice mask, flow, out;
+  template <typename F>
+  void accesses(F&& f) const { f(mask, Access::read); f(flow, Access::read); f(out, Access::write); }
+};
+
+// The pass's result, handed to the host.
+struct Output {
+  Slice flow;
+  template <typename F>
+  void accesses(F&& f) const { f(flow, Access::read); }
+};
+
+// The end of a named stage (stage_observer.hpp): where the timestamps go, and what an observer
+// sees there, each tensor under its own name.
+struct StageEnd {
+  struct Observed {
+    std::string name;
+    int frame = 0;
+    Slice tensor;
+  };
+  std::string name;
+  std::vector<Observed> observed;
+  template <typename F>
+  void accesses(F&& f) const {
+    for (const auto& o : observed) f(o.tensor, Access::read);
+  }
+};
+
+template <typename T>
+using Op = std::variant<FrameInput, AvgPool2x, Conv2d<T>, Linear<T>, Attention, LayerNorm<T>, ChannelAffine<T>,
+                        GlobalMatching, Resample, Copy, Zero, LocalCorrelation, RefineUpdate, ConvexUpsample, Output,
+                        StageEnd>;
+
+template <typename T>
+using OpList = std::vector<Op<T>>;
+
+}  // namespace neuflow::model::graph

@@ -1,0 +1,19 @@
+#include "vulkan/ops/record_op.hpp"
+
+namespace neuflow::model::vulkan {
+
+void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op) {
+  const View in = r.view(op.in), out = r.view(op.out);
+  const View residual = op.residual ? r.view(*op.residual) : View{};
+  const int tokens = in.h * in.w;
+  const LayerNormParams p{in.c,
+                          tokens,
+                          in.offset(),
+                          out.offset(),
+                          op.residual ? residual.offset() : -1,
+                          op.weights->gamma.offset,
+                          op.weights->beta.offset};
+  r.dispatch<Shader::layer_norm>({&r.weights(), in.buffer, out.buffer, residual.buffer}, p, groups(tokens, kLocal));
+}
+
+}  // namespace neuflow::model::vulkan

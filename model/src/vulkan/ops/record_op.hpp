@@ -1,0 +1,34 @@
+#pragma once
+// Each graph op as Vulkan commands, one file per op (ncnn's layer/vulkan/ habit): a new kernel
+// for an op replaces that op's file, and a new op adds one file here and one in the CPU's.
+#include "graph/ops.hpp"
+#include "vulkan/device_weights.hpp"
+#include "vulkan/network_recorder.hpp"
+
+namespace neuflow::model::vulkan {
+
+using Recorder = VulkanNetwork::Recorder;
+
+void record_op(Recorder& r, const graph::FrameInput& op);
+void record_op(Recorder& r, const graph::AvgPool2x& op);
+void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op);
+void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op);
+void record_op(Recorder& r, const graph::Attention& op);
+void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op);
+void record_op(Recorder& r, const graph::ChannelAffine<DeviceTensor>& op);
+void record_op(Recorder& r, const graph::GlobalMatching& op);
+void record_op(Recorder& r, const graph::Resample& op);
+void record_op(Recorder& r, const graph::Copy& op);
+void record_op(Recorder& r, const graph::Zero& op);
+void record_op(Recorder& r, const graph::LocalCorrelation& op);
+void record_op(Recorder& r, const graph::RefineUpdate& op);
+void record_op(Recorder& r, const graph::ConvexUpsample& op);
+void record_op(Recorder& r, const graph::Output& op);
+void record_op(Recorder& r, const graph::StageEnd& op);
+
+// The shaders without offsets in their parameters take whole buffers.
+inline void require_whole(const View& v, const char* what) {
+  if (v.offset() != 0) throw std::logic_error(std::string("the Vulkan ") + what + " needs a tensor of its own");
+}
+
+}  // namespace neuflow::model::vulkan
