@@ -6,9 +6,9 @@
 // convolution's arithmetic for both, so Winograd's figure can exceed the sgemm peak measured
 // first.
 //
-// With --arena, instead: the CPU plan's transient-activation arena at that size, region by
-// region (one per stage; regions overlap, so the arena is the largest), in MB and bytes per
-// model pixel, for both ways of computing the convolutions.
+// With --arena, instead: the CPU plan's memory at that size, in MB and bytes per model pixel,
+// for both ways of computing the convolutions: its one allocation (the graph's tensors and the
+// ops' scratch, placed from their live ranges) and the largest scratch of one op within it.
 //
 //   neuflow-bench-conv [--size 768x432] [--threads 2] [--runs 10] [--arena [--model CKPT]]
 #include <omp.h>
@@ -90,19 +90,16 @@ int print_arena(const std::string& model_path, int width, int height) {
     return 66;
   }
   const double pixels = static_cast<double>(width) * height;
-  std::printf("arena at %dx%d (%.2f Mpixel), MB and bytes per pixel\n", width, height, pixels / 1e6);
-  std::printf("%-12s %8s %8s %8s %8s %8s\n", "region", "buffers", "direct", "B/px", "winograd", "B/px");
+  std::printf("memory at %dx%d (%.2f Mpixel), MB and bytes per pixel\n", width, height, pixels / 1e6);
+  std::printf("%-10s %8s %8s %8s %8s\n", "", "direct", "B/px", "winograd", "B/px");
   const NetworkPlan direct(model->weights(), height, width, CpuConvolution::direct);
   const NetworkPlan winograd(model->weights(), height, width, CpuConvolution::winograd);
-  const auto& d = direct.arena().regions();
-  const auto& w = winograd.arena().regions();
-  for (std::size_t i = 0; i < d.size() && i < w.size(); ++i) {
-    std::printf("%-12s %8d %8.1f %8.0f %8.1f %8.0f\n", d[i].name.c_str(), d[i].buffers, d[i].bytes / 1e6,
-                d[i].bytes / pixels, w[i].bytes / 1e6, w[i].bytes / pixels);
-  }
-  std::printf("%-12s %8s %8.1f %8.0f %8.1f %8.0f\n", "arena", "", direct.arena().size_bytes() / 1e6,
-              direct.arena().size_bytes() / pixels, winograd.arena().size_bytes() / 1e6,
-              winograd.arena().size_bytes() / pixels);
+  const auto row = [&](const char* name, std::size_t d, std::size_t w) {
+    std::printf("%-10s %8.1f %8.0f %8.1f %8.0f\n", name, d / 1e6, d / pixels, w / 1e6, w / pixels);
+  };
+  const NetworkPlan::Memory d = direct.memory(), w = winograd.memory();
+  row("allocation", d.allocation, w.allocation);
+  row("op scratch", d.largest_scratch, w.largest_scratch);
   return 0;
 }
 

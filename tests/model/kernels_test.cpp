@@ -8,7 +8,7 @@
 
 #include "dnnl/context.hpp"
 #include "dnnl/conv_op.hpp"
-#include "ops/local_correlation.hpp"
+#include "kernels/local_correlation.hpp"
 #include "tensor.hpp"
 
 namespace neuflow::model {

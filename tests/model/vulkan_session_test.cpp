@@ -484,8 +484,9 @@ TEST_F(VulkanSession, DeviceTimestampsTimeEveryStageOfAFrame) {
     EXPECT_GE(t.milliseconds, 0) << t.name;
     device_ms += t.milliseconds;
   }
-  // A streamed frame encodes one frame, then runs the flow pass.
-  std::vector<std::string> expected{"backbone_s8", "backbone_s16", "conv_s8"};
+  // A streamed frame encodes one frame (the upsampler's features first, as the graph orders
+  // them), then runs the flow pass.
+  std::vector<std::string> expected{"conv_s8", "backbone_s8", "backbone_s16"};
   expected.insert(expected.end(), flow_stages.begin(), flow_stages.end());
   EXPECT_EQ(timed, expected);
   // attention, matching, one 1/16 iteration, two merges, two 1/8 iterations, the upsampled flow

@@ -5,6 +5,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace neuflow::model::graph {
 
@@ -12,7 +13,11 @@ namespace {
 
 bool planned(const TensorDesc& d) { return d.storage == Storage::transient; }
 
-bool meet(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) {
+bool meet(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) { return live_at_once(a, b); }
+
+}  // namespace
+
+bool live_at_once(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) {
   for (const LiveRange& x : a) {
     for (const LiveRange& y : b) {
       if (x.first <= y.last && y.first <= x.last) return true;
@@ -21,7 +26,34 @@ bool meet(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) {
   return false;
 }
 
-}  // namespace
+OffsetPlan plan_offsets(const std::vector<std::size_t>& bytes, const LiveRanges& ranges, std::size_t alignment) {
+  OffsetPlan plan;
+  plan.offset.assign(bytes.size(), 0);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (!ranges[i].empty() && bytes[i] > 0) order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return bytes[a] > bytes[b]; });
+  const auto align = [&](std::size_t n) { return (n + alignment - 1) / alignment * alignment; };
+  std::vector<std::size_t> placed;
+  for (const std::size_t i : order) {
+    // The blocks already placed that are live with this one, by offset: the first gap that fits.
+    std::vector<std::pair<std::size_t, std::size_t>> busy;
+    for (const std::size_t p : placed) {
+      if (live_at_once(ranges[i], ranges[p])) busy.emplace_back(plan.offset[p], plan.offset[p] + bytes[p]);
+    }
+    std::sort(busy.begin(), busy.end());
+    std::size_t at = 0;
+    for (const auto& [begin, end] : busy) {
+      if (at + bytes[i] <= begin) break;
+      at = std::max(at, align(end));
+    }
+    plan.offset[i] = at;
+    plan.size = std::max(plan.size, at + bytes[i]);
+    placed.push_back(i);
+  }
+  return plan;
+}
 
 template <typename T>
 LiveRanges live_ranges(const TensorTable& tensors, const std::vector<const OpList<T>*>& passes) {
@@ -30,7 +62,8 @@ LiveRanges live_ranges(const TensorTable& tensors, const std::vector<const OpLis
   int index = 0;
   for (const OpList<T>* pass : passes) {
     std::fill(open.begin(), open.end(), false);
-    for (const Op<T>& op : *pass) {
+    for (const Node<T>& node : *pass) {
+      const Op<T>& op = node.op;
       // Reads first: an op that reads and writes a tensor continues its range.
       std::vector<TensorId> read;
       std::visit(
@@ -123,8 +156,8 @@ MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges) {
 void check_plan(const TensorTable& tensors, const MemoryPlan& plan, const LiveRanges& ranges) {
   for (std::size_t a = 0; a < tensors.size(); ++a) {
     if (ranges[a].empty()) continue;
-    if (plan.region[a] < 0 || tensors.at(static_cast<TensorId>(a)).count() >
-                                  plan.region_size[static_cast<std::size_t>(plan.region[a])]) {
+    if (plan.region[a] < 0 ||
+        tensors.at(static_cast<TensorId>(a)).count() > plan.region_size[static_cast<std::size_t>(plan.region[a])]) {
       throw std::logic_error("the memory plan has no room for " + tensors.at(static_cast<TensorId>(a)).name);
     }
     for (std::size_t b = a + 1; b < tensors.size(); ++b) {

@@ -4,6 +4,8 @@
 // region (never one for all of them: a GPU's largest buffer is often 128 MiB or so) and gives
 // persistent and frame tensors memory of their own.
 #include <cstddef>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "graph/ops.hpp"
@@ -34,8 +36,41 @@ struct MemoryPlan {
 // tensors' ranges it does not meet and that needs the least growth.
 MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges);
 
+// Offsets in one allocation (a CPU's): each block of bytes at the lowest offset, aligned, free
+// throughout its ranges; the largest blocks placed first, which leaves less unused between them
+// than placing them as they come. Blocks without ranges get no place (offset 0, never used).
+struct OffsetPlan {
+  std::vector<std::size_t> offset;  // per block
+  std::size_t size = 0;             // bytes the allocation needs
+};
+OffsetPlan plan_offsets(const std::vector<std::size_t>& bytes, const LiveRanges& ranges, std::size_t alignment);
+
+// std::logic_error when two blocks that overlap in the allocation are live at once under
+// `ranges`; `name(i)` names block i.
+template <typename Name>
+void check_offsets(const OffsetPlan& plan, const std::vector<std::size_t>& bytes, const LiveRanges& ranges,
+                   const Name& name);
+
+// Whether two tensors' ranges meet.
+bool live_at_once(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b);
+
 // std::logic_error naming both tensors when two tensors of one region are live at once under
 // `ranges` (the ranges of other passes than the plan was made for, e.g. other iterations).
 void check_plan(const TensorTable& tensors, const MemoryPlan& plan, const LiveRanges& ranges);
+
+template <typename Name>
+void check_offsets(const OffsetPlan& plan, const std::vector<std::size_t>& bytes, const LiveRanges& ranges,
+                   const Name& name) {
+  for (std::size_t a = 0; a < bytes.size(); ++a) {
+    if (ranges[a].empty()) continue;
+    for (std::size_t b = a + 1; b < bytes.size(); ++b) {
+      if (ranges[b].empty()) continue;
+      const bool overlap = plan.offset[a] < plan.offset[b] + bytes[b] && plan.offset[b] < plan.offset[a] + bytes[a];
+      if (overlap && live_at_once(ranges[a], ranges[b])) {
+        throw std::logic_error("the memory plan overlaps " + name(a) + " and " + name(b) + ", which are live at once");
+      }
+    }
+  }
+}
 
 }  // namespace neuflow::model::graph

@@ -1,5 +1,6 @@
 #include "graph/network_graph.hpp"
 
+#include <algorithm>
 #include <array>
 #include <stdexcept>
 #include <utility>
@@ -18,7 +19,10 @@ class Builder {
   Builder(NetworkGraph<T>& graph, int block_rows, int tokens) : g_(graph), block_rows_(block_rows), tokens_(tokens) {}
 
   void into(OpList<T>& ops) { ops_ = &ops; }
-  void emit(Op<T> op) { ops_->push_back(std::move(op)); }
+  void emit(Op<T> op) {
+    ops_->push_back({next_id_++, std::move(op)});
+    g_.op_ids = std::max(g_.op_ids, next_id_);
+  }
 
   TensorId tensor(std::string name, int c, int h, int w, Storage storage = Storage::transient,
                   std::optional<ConstantChannels> constant = std::nullopt) {
@@ -31,8 +35,8 @@ class Builder {
   }
   Slice all(TensorId id) const { return g_.tensors.all(id); }
 
-  void conv(const BasicConvWeights<T>& w, std::string layer, Slice in, Slice out, int stride, int pad,
-            Activation act, std::optional<Slice> addend = std::nullopt) {
+  void conv(const BasicConvWeights<T>& w, std::string layer, Slice in, Slice out, int stride, int pad, Activation act,
+            std::optional<Slice> addend = std::nullopt) {
     emit(Conv2d<T>{&w, std::move(layer), in, out, stride, pad, act, addend});
   }
   void linear(const BasicLinearWeights<T>& w, std::string layer, Slice in, Slice out,
@@ -75,8 +79,8 @@ class Builder {
 
   // `iterations` refinement steps of `flow` at its scale, from the pair's features and the
   // context in channels 0..63 of `constant_input` (its channel 64 is the radius plane).
-  void refinement(const BasicRefineWeights<T>& w, const std::string& layer, std::string_view scale, Slice f0,
-                  Slice f1, TensorId flow, TensorId constant_input, int iterations) {
+  void refinement(const BasicRefineWeights<T>& w, const std::string& layer, std::string_view scale, Slice f0, Slice f1,
+                  TensorId flow, TensorId constant_input, int iterations) {
     const TensorId input = like(layer + ".input", kRefineDynamicChannels, flow);
     const Slice corr = all(input).channels(0, kCorrChannels),
                 hidden = all(input).channels(kRefineHiddenOffset, kHiddenChannels),
@@ -93,7 +97,7 @@ class Builder {
       layers[i] = like(layer + ".conv_layers." + std::to_string(i), w.conv_layers[i].out_channels, flow);
     }
     const TensorId update = like(layer + ".conv3", kRefineOutputChannels, flow);
-    for (int i = 0; i < iterations; ++i) {
+    const auto step = [&](int i) {
       emit(LocalCorrelation{f0, f1, all(flow), corr});
       conv(w.conv1_dynamic, layer + ".conv1.conv", all(input), all(x1), 1, 1, Activation::leaky_relu, all(constant));
       conv(w.conv2, layer + ".conv2.conv", all(x1), all(x2), 1, 1, Activation::leaky_relu);
@@ -110,7 +114,23 @@ class Builder {
                     {{stage::corr_iteration(scale, i), 0, corr},
                      {it + "_hidden", 0, hidden},
                      {it + "_delta", 0, all(update).channels(0, 2)}}});
+    };
+    loop(iterations, step);
+  }
+
+  // Every iteration emits the same ops, so they take the same ids; without iterations the ids
+  // are still taken (into a list thrown away), so no id depends on the iteration count.
+  template <typename Step>
+  void loop(int iterations, const Step& step) {
+    const int first_id = next_id_;
+    OpList<T> discarded;
+    OpList<T>* ops = ops_;
+    if (iterations == 0) ops_ = &discarded;
+    for (int i = 0; i < std::max(iterations, 1); ++i) {
+      next_id_ = first_id;
+      step(i);
     }
+    ops_ = ops;
   }
 
   // The score blocks of the attention and the matching: one tensor, reused by all of them.
@@ -123,6 +143,7 @@ class Builder {
   NetworkGraph<T>& g_;
   OpList<T>* ops_ = nullptr;
   int block_rows_, tokens_;
+  int next_id_ = 0;
   TensorId scores_ = -1;
 };
 
@@ -168,6 +189,10 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   b.emit(AvgPool2x{b.all(input), b.all(half)});
   b.emit(AvgPool2x{b.all(half), b.all(quarter)});
   b.emit(AvgPool2x{b.all(quarter), b.all(eighth)});
+  // The upsampler's features first: the full-size input (25 MB at 1920×1088) is then no longer
+  // alive when the 1/8 concatenation, the encoding's largest moment, is.
+  b.conv_block(w.conv_s8, "conv_s8", b.all(input), 8, 0, b.all(encoded.up));
+  b.emit(StageEnd{str(stage::conv_s8), {}});
   const TensorId cat8 = b.tensor("backbone.cat_8", 384, h8, w8);
   b.conv_block(w.block_8_1, "backbone.block_8_1", b.all(half), 4, 2, b.all(cat8).channels(0, 256));
   b.conv_block(w.block_8_2, "backbone.block_8_2", b.all(quarter), 2, 2, b.all(cat8).channels(256, 128));
@@ -179,8 +204,6 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   b.conv_block(w.block_cat_16, "backbone.block_cat_16", b.all(cat16), 1, 1,
                b.all(encoded.f16).channels(0, kBackbone16Channels));
   b.emit(StageEnd{str(stage::backbone_s16), {}});
-  b.conv_block(w.conv_s8, "conv_s8", b.all(input), 8, 0, b.all(encoded.up));
-  b.emit(StageEnd{str(stage::conv_s8), {}});
 
   // ---- a pair's flow -------------------------------------------------------------------------
   b.into(g.flow);
@@ -209,7 +232,8 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   const auto features_of = [&](TensorId t) { return b.all(t).channels(kContextChannels, kMatchingChannels); };
 
   // Global matching.
-  const TensorId grid = b.tensor("matching.grid", 2, h16, w16, Storage::persistent, ConstantChannels{0, 2, Fill::grid_xy});
+  const TensorId grid =
+      b.tensor("matching.grid", 2, h16, w16, Storage::persistent, ConstantChannels{0, 2, Fill::grid_xy});
   const TensorId correspondence = b.tensor("matching.correspondence", 2, h16, w16);
   const TensorId flow16 = b.tensor("flow_s16", 2, h16, w16);
   b.emit(GlobalMatching{features_of(att0), features_of(att1), b.all(grid), b.all(flow16), b.scores(), correspondence,
@@ -232,8 +256,8 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
     const std::string at = "merge_s8.frame" + std::to_string(f);
     const TensorId in = b.tensor(at + ".input", 2 * kMatchingChannels, h8, w8);
     b.emit(Copy{features_of(pair[f].first), b.all(in).channels(0, kMatchingChannels)});
-    b.emit(Resample{features_of(pair[f].second), b.all(in).channels(kMatchingChannels, kMatchingChannels), 2, false,
-                    1.f});
+    b.emit(
+        Resample{features_of(pair[f].second), b.all(in).channels(kMatchingChannels, kMatchingChannels), 2, false, 1.f});
     const TensorId mid = b.tensor(at + ".0", kMatchingChannels, h8, w8);
     b.conv(w.merge_s8_0, "merge_s8.0", b.all(in), b.all(mid), 1, 1, Activation::gelu);
     merged[f] = b.tensor(at, kMatchingChannels, h8, w8);
@@ -246,8 +270,8 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   b.emit(Resample{context_of(att0), b.all(context_in).channels(kContextChannels, kContextChannels), 2, true, 1.f});
   const TensorId context_mid = b.tensor("context_merge_s8.0", kContextChannels, h8, w8);
   b.conv(w.context_merge_s8_0, "context_merge_s8.0", b.all(context_in), b.all(context_mid), 1, 1, Activation::gelu);
-  const TensorId constant8 = b.tensor("refine_s8.constant_input", kRefineConstantChannels, h8, w8,
-                                      Storage::persistent, ConstantChannels{kContextChannels, 1, Fill::radius_plane});
+  const TensorId constant8 = b.tensor("refine_s8.constant_input", kRefineConstantChannels, h8, w8, Storage::persistent,
+                                      ConstantChannels{kContextChannels, 1, Fill::radius_plane});
   const Slice context8 = b.all(constant8).channels(0, kContextChannels);
   b.conv(w.context_merge_s8_2, "context_merge_s8.2", b.all(context_mid), context8, 1, 1, Activation::none);
   b.emit(StageEnd{str(stage::context_merge_s8), {{str(stage::context_merge_s8), 0, context8}}});
@@ -273,8 +297,8 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   return g;
 }
 
-template NetworkGraph<std::vector<float>> build_network_graph(const BasicNetworkWeights<std::vector<float>>&, int,
-                                                              int, const Iterations&, int);
+template NetworkGraph<std::vector<float>> build_network_graph(const BasicNetworkWeights<std::vector<float>>&, int, int,
+                                                              const Iterations&, int);
 template NetworkGraph<PackedTensor> build_network_graph(const BasicNetworkWeights<PackedTensor>&, int, int,
                                                         const Iterations&, int);
 

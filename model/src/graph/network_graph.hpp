@@ -15,9 +15,10 @@ namespace neuflow::model::graph {
 template <typename T>
 struct NetworkGraph {
   TensorTable tensors;
-  OpList<T> encode;        // writes the encoded frame's frame tensors
-  OpList<T> flow;          // reads the first and second frames' frame tensors
-  TensorId output = -1;    // the flow at model resolution, [2][height][width]
+  OpList<T> encode;      // writes the encoded frame's frame tensors
+  OpList<T> flow;        // reads the first and second frames' frame tensors
+  TensorId output = -1;  // the flow at model resolution, [2][height][width]
+  int op_ids = 0;        // the nodes' ids are 0 .. op_ids - 1
   int height = 0, width = 0;
 };
 

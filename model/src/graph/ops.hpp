@@ -23,14 +23,19 @@ enum class Access { read, write };
 struct FrameInput {
   Slice out;
   template <typename F>
-  void accesses(F&& f) const { f(out, Access::write); }
+  void accesses(F&& f) const {
+    f(out, Access::write);
+  }
 };
 
 // 2×2 average pooling.
 struct AvgPool2x {
   Slice in, out;
   template <typename F>
-  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+  void accesses(F&& f) const {
+    f(in, Access::read);
+    f(out, Access::write);
+  }
 };
 
 // out = act(conv(in) + bias (+ addend)); `layer` is the architecture table's name.
@@ -58,7 +63,10 @@ struct Linear {
   Slice in, out;
   Activation act = Activation::none;
   template <typename F>
-  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+  void accesses(F&& f) const {
+    f(in, Access::read);
+    f(out, Access::write);
+  }
 };
 
 // Attention over all tokens: out[:, i] = Σ_j softmax_j(q[:, i] · k[:, j]) v[:, j] (the scale is
@@ -69,7 +77,9 @@ struct Attention {
   int block_rows = 1;
   template <typename F>
   void accesses(F&& f) const {
-    f(q, Access::read); f(k, Access::read); f(v, Access::read);
+    f(q, Access::read);
+    f(k, Access::read);
+    f(v, Access::read);
     f({scores, 0, 1}, Access::write);
     f(out, Access::write);
   }
@@ -98,7 +108,10 @@ struct ChannelAffine {
   std::string layer;
   Slice inout;
   template <typename F>
-  void accesses(F&& f) const { f(inout, Access::read); f(inout, Access::write); }
+  void accesses(F&& f) const {
+    f(inout, Access::read);
+    f(inout, Access::write);
+  }
 };
 
 // Flow at 1/16 from all-pairs matching: softmax(f0 · f1ᵀ / √c) · grid - grid, in blocks of
@@ -109,7 +122,9 @@ struct GlobalMatching {
   int block_rows = 1;
   template <typename F>
   void accesses(F&& f) const {
-    f(f0, Access::read); f(f1, Access::read); f(grid, Access::read);
+    f(f0, Access::read);
+    f(f1, Access::read);
+    f(grid, Access::read);
     f({scores, 0, 1}, Access::write);
     f({correspondence, 0, 2}, Access::write);
     f(out, Access::write);
@@ -123,19 +138,27 @@ struct Resample {
   bool relu = false;
   float scale = 1.f;
   template <typename F>
-  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+  void accesses(F&& f) const {
+    f(in, Access::read);
+    f(out, Access::write);
+  }
 };
 
 struct Copy {
   Slice in, out;
   template <typename F>
-  void accesses(F&& f) const { f(in, Access::read); f(out, Access::write); }
+  void accesses(F&& f) const {
+    f(in, Access::read);
+    f(out, Access::write);
+  }
 };
 
 struct Zero {
   Slice out;
   template <typename F>
-  void accesses(F&& f) const { f(out, Access::write); }
+  void accesses(F&& f) const {
+    f(out, Access::write);
+  }
 };
 
 // The 9×9 window of f0 · f1 around each pixel displaced by the flow, divided by √c.
@@ -143,7 +166,9 @@ struct LocalCorrelation {
   Slice f0, f1, flow, out;
   template <typename F>
   void accesses(F&& f) const {
-    f(f0, Access::read); f(f1, Access::read); f(flow, Access::read);
+    f(f0, Access::read);
+    f(f1, Access::read);
+    f(flow, Access::read);
     f(out, Access::write);
   }
 };
@@ -154,8 +179,11 @@ struct RefineUpdate {
   Slice update, hidden, flow_copy, flow;
   template <typename F>
   void accesses(F&& f) const {
-    f(update, Access::read); f(flow, Access::read);
-    f(hidden, Access::write); f(flow_copy, Access::write); f(flow, Access::write);
+    f(update, Access::read);
+    f(flow, Access::read);
+    f(hidden, Access::write);
+    f(flow_copy, Access::write);
+    f(flow, Access::write);
   }
 };
 
@@ -164,14 +192,20 @@ struct RefineUpdate {
 struct ConvexUpsample {
   Slice mask, flow, out;
   template <typename F>
-  void accesses(F&& f) const { f(mask, Access::read); f(flow, Access::read); f(out, Access::write); }
+  void accesses(F&& f) const {
+    f(mask, Access::read);
+    f(flow, Access::read);
+    f(out, Access::write);
+  }
 };
 
 // The pass's result, handed to the host.
 struct Output {
   Slice flow;
   template <typename F>
-  void accesses(F&& f) const { f(flow, Access::read); }
+  void accesses(F&& f) const {
+    f(flow, Access::read);
+  }
 };
 
 // The end of a named stage (stage_observer.hpp): where the timestamps go, and what an observer
@@ -191,11 +225,20 @@ struct StageEnd {
 };
 
 template <typename T>
-using Op = std::variant<FrameInput, AvgPool2x, Conv2d<T>, Linear<T>, Attention, LayerNorm<T>, ChannelAffine<T>,
-                        GlobalMatching, Resample, Copy, Zero, LocalCorrelation, RefineUpdate, ConvexUpsample, Output,
-                        StageEnd>;
+using Op =
+    std::variant<FrameInput, AvgPool2x, Conv2d<T>, Linear<T>, Attention, LayerNorm<T>, ChannelAffine<T>, GlobalMatching,
+                 Resample, Copy, Zero, LocalCorrelation, RefineUpdate, ConvexUpsample, Output, StageEnd>;
+
+// An op in a pass. `id` names the op across the passes and the refinements' iterations: each
+// iteration repeats the same ops (same ids) on the same tensors, so a backend builds what an op
+// needs (a primitive, a pipeline) once per id, however many iterations a pass runs.
+template <typename T>
+struct Node {
+  int id = 0;
+  Op<T> op;
+};
 
 template <typename T>
-using OpList = std::vector<Op<T>>;
+using OpList = std::vector<Node<T>>;
 
 }  // namespace neuflow::model::graph

@@ -59,9 +59,7 @@ class Checker {
             "channels " + std::to_string(s.channel) + "+" + std::to_string(s.c) + " of " + desc(s).name + " (" +
                 std::to_string(desc(s).c) + " channels)");
   }
-  bool same_plane(const Slice& a, const Slice& b) const {
-    return desc(a).h == desc(b).h && desc(a).w == desc(b).w;
-  }
+  bool same_plane(const Slice& a, const Slice& b) const { return desc(a).h == desc(b).h && desc(a).w == desc(b).w; }
 
   void check_op(const Conv2d<T>& o) {
     const BasicConvWeights<T>& w = *o.weights;
@@ -96,9 +94,9 @@ class Checker {
     require(neuflow_v2_layer(o.layer).out == o.inout.c, "a width unlike the architecture table's layer");
   }
   void check_op(const Attention& o) {
-    require(o.q.c == o.k.c && o.v.c == o.out.c && same_plane(o.q, o.k) && same_plane(o.k, o.v) &&
-                same_plane(o.q, o.out),
-            "queries, keys, values and output of different shapes");
+    require(
+        o.q.c == o.k.c && o.v.c == o.out.c && same_plane(o.q, o.k) && same_plane(o.k, o.v) && same_plane(o.q, o.out),
+        "queries, keys, values and output of different shapes");
     require(desc({o.scores, 0, 1}).count() >= static_cast<std::size_t>(o.block_rows) * desc(o.k).plane(),
             "a score block smaller than its rows");
   }
@@ -149,7 +147,7 @@ template <typename T>
 void check_shapes(const NetworkGraph<T>& graph) {
   Checker<T> checker(graph);
   for (const auto* ops : {&graph.encode, &graph.flow}) {
-    for (const Op<T>& op : *ops) checker.check(op);
+    for (const Node<T>& node : *ops) checker.check(node.op);
   }
 }
 

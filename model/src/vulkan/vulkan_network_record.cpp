@@ -14,7 +14,7 @@
 namespace neuflow::model::vulkan {
 
 void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) {
-  for (const auto& op : ops) std::visit([&](const auto& o) { record_op(r, o); }, op);
+  for (const auto& node : ops) std::visit([&](const auto& o) { record_op(r, o); }, node.op);
 }
 
 void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* frame) {
@@ -68,10 +68,10 @@ void VulkanNetwork::allocate_tensors() {
   // The largest range the passes zero, and the largest tensor an observer reads back.
   std::size_t zeroed = 1, observed = 2 * hw;
   for (const auto* ops : {&graph_.encode, &graph_.flow}) {
-    for (const auto& op : *ops) {
-      if (const auto* z = std::get_if<graph::Zero>(&op)) {
+    for (const auto& node : *ops) {
+      if (const auto* z = std::get_if<graph::Zero>(&node.op)) {
         zeroed = std::max(zeroed, static_cast<std::size_t>(z->out.c) * graph_.tensors.at(z->out.tensor).plane());
-      } else if (const auto* s = std::get_if<graph::StageEnd>(&op)) {
+      } else if (const auto* s = std::get_if<graph::StageEnd>(&node.op)) {
         for (const auto& o : s->observed) {
           observed =
               std::max(observed, static_cast<std::size_t>(o.tensor.c) * graph_.tensors.at(o.tensor.tensor).plane());

@@ -44,8 +44,8 @@ inline std::string corr_iteration(std::string_view scale, int i) { return corr_p
 
 // How long a stage ran on the device, from the GPU's own timestamps (FlowSession::
 // device_stage_times()). Named as the observer's stages, except that a refinement iteration is
-// one stage ("refine_s8_iter0"); each runs from the end of the stage before it ("backbone_s8"
-// of a frame's encoding from the frame's upload, "merge_s8" includes resampling the flow to 1/8).
+// one stage ("refine_s8_iter0"); each runs from the end of the stage before it ("conv_s8", a
+// frame's first, from the frame's upload; "merge_s8" includes resampling the flow to 1/8).
 struct StageTime {
   std::string name;
   double milliseconds;

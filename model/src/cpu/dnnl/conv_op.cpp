@@ -74,10 +74,15 @@ WinogradTile winograd_tile(CpuConvolution choice, const ConvWeights& w, const Co
   return WinogradConv::faster_tile(w.in_channels * p.stride * p.stride, w.out_channels, height, width);
 }
 
+// In the arena, or without memory until set_output() gives it some.
+memory output_memory(const memory::desc& desc, ScratchArena& arena, bool own_output) {
+  return own_output ? arena.make(desc) : memory(desc, cpu_engine(), DNNL_MEMORY_NONE);
+}
+
 }  // namespace
 
 ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& input, PlanContext& context,
-               std::optional<memory::desc> output)
+               std::optional<memory::desc> output, bool own_output)
     : accumulate_(p.accumulate) {
   ScratchArena& arena = context.arena;
   const auto& eng = cpu_engine();
@@ -111,7 +116,7 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
     }
     winograd_.emplace(w, winograd_params, in_h, in_w, *winograd_layout(in_desc), *winograd_layout(out_desc),
                       winograd_tile(context.convolution, w, p, out_h_, out_w_), arena);
-    dst_ = arena.make(out_desc);
+    dst_ = output_memory(out_desc, arena, own_output);
     return;
   }
 
@@ -140,7 +145,7 @@ ConvOp::ConvOp(const ConvWeights& w, const ConvParams& p, const memory::desc& in
   }
   s.wait();
 
-  dst_ = arena.make(pd.dst_desc());
+  dst_ = output_memory(pd.dst_desc(), arena, own_output);
   if (pd.src_desc() != input) {
     reordered_input_ = arena.make(pd.src_desc());
     input_reorder_ = dnnl::reorder(dnnl::reorder::primitive_desc(eng, input, eng, pd.src_desc()));

@@ -19,8 +19,9 @@ class ConvOp {
   // `input` describes the memory run() will receive: NHWC from a stage, or a previous
   // ConvOp's output(). The output and any reordered input live in the context's arena
   // (current region). `output` forces the output layout (default: the primitive's choice).
+  // Without `own_output`, the output has no memory until set_output() gives it some.
   ConvOp(const ConvWeights& weights, const ConvParams& params, const dnnl::memory::desc& input, PlanContext& context,
-         std::optional<dnnl::memory::desc> output = std::nullopt);
+         std::optional<dnnl::memory::desc> output = std::nullopt, bool own_output = true);
 
   // Runs the convolution; `addend` (required iff params.accumulate) must have output_desc().
   const dnnl::memory& run(dnnl::stream& stream, const dnnl::memory& input, const dnnl::memory* addend = nullptr);
@@ -29,6 +30,8 @@ class ConvOp {
   void run_to_nhwc(dnnl::stream& stream, const dnnl::memory& input, Tensor& out, const dnnl::memory* addend = nullptr);
 
   const dnnl::memory& output() const { return dst_; }
+  // From now on the output goes to `data` (laid out as output_desc()).
+  void set_output(void* data) { dst_.set_data_handle(data); }
   dnnl::memory::desc output_desc() const { return dst_.get_desc(); }
   int out_h() const { return out_h_; }
   int out_w() const { return out_w_; }

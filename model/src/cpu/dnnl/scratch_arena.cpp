@@ -13,7 +13,7 @@ std::size_t align_up(std::size_t v) { return (v + kAlignment - 1) / kAlignment *
 }  // namespace
 
 dnnl::memory ScratchArena::make(const dnnl::memory::desc& desc) {
-  if (storage_) throw std::logic_error("ScratchArena: make() after finalize()");
+  if (planned_) throw std::logic_error("ScratchArena: make() after finalize()");
   dnnl::memory m(desc, cpu_engine(), DNNL_MEMORY_NONE);
   bindings_.push_back({m, align_up(desc.get_size()), regions_.size() - 1, events_++});
   ++regions_.back().buffers;
@@ -79,9 +79,21 @@ void ScratchArena::place_region(std::size_t region) {
 }
 
 void ScratchArena::finalize() {
-  for (std::size_t r = 0; r < regions_.size(); ++r) place_region(r);
-  storage_.reset(new std::byte[size_ + kAlignment]);
-  auto* base = reinterpret_cast<std::byte*>(align_up(reinterpret_cast<std::size_t>(storage_.get())));
+  const std::size_t bytes = plan();
+  storage_.reset(new std::byte[bytes + kAlignment]);
+  bind(reinterpret_cast<std::byte*>(align_up(reinterpret_cast<std::size_t>(storage_.get()))));
+}
+
+std::size_t ScratchArena::plan() {
+  if (!planned_) {
+    for (std::size_t r = 0; r < regions_.size(); ++r) place_region(r);
+    planned_ = true;
+  }
+  return size_;
+}
+
+void ScratchArena::bind(std::byte* base) {
+  plan();
   for (auto& b : bindings_) {
     b.memory.set_data_handle(base + b.offset);
     if (b.tensor)

@@ -47,6 +47,10 @@ class ScratchArena {
 
   // Allocates the largest region's size once and binds every memory made so far.
   void finalize();
+  // Or in two steps, into memory of the caller's: the bytes it needs (offsets chosen), then
+  // every memory bound at `base` (aligned to 64 bytes, plan() bytes long, kept by the caller).
+  std::size_t plan();
+  void bind(std::byte* base);
 
   std::size_t size_bytes() const { return size_; }
 
@@ -67,6 +71,7 @@ class ScratchArena {
   std::vector<Region> regions_{1};
   std::size_t events_ = 0;
   std::size_t size_ = 0;
+  bool planned_ = false;
   std::unique_ptr<std::byte[]> storage_;
 };
 

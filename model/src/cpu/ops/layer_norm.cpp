@@ -1,25 +1,18 @@
-#include "ops/layer_norm.hpp"
-
-#include <cmath>
+#include "kernels/layer_norm.hpp"
+#include "ops/cpu_op.hpp"
 
 namespace neuflow::model {
 
-void layer_norm_rows(float* data, int rows, int dim, const std::vector<float>& gamma, const std::vector<float>& beta) {
-  constexpr double kEps = 1e-5;
-#pragma omp parallel for
-  for (int r = 0; r < rows; ++r) {
-    float* x = data + static_cast<std::size_t>(r) * dim;
-    double mean = 0.0;
-    for (int i = 0; i < dim; ++i) mean += x[i];
-    mean /= dim;
-    double var = 0.0;
-    for (int i = 0; i < dim; ++i) var += (x[i] - mean) * (x[i] - mean);
-    var /= dim;
-    const double inv = 1.0 / std::sqrt(var + kEps);
-    for (int i = 0; i < dim; ++i) {
-      x[i] = static_cast<float>((x[i] - mean) * inv) * gamma[i] + beta[i];
-    }
-  }
+std::unique_ptr<CpuOp> build_op(const graph::LayerNorm<HostTensor>& op, OpBuild&) {
+  return make_op([op](OpRun& pass) {
+    TensorStore& t = pass.tensors;
+    Tensor& in = t.nhwc(op.in.tensor);
+    Tensor& out = t.nhwc(op.out.tensor);
+    Tensor* residual = op.residual ? &t.nhwc(op.residual->tensor) : nullptr;
+    layer_norm_rows({in.data.data() + op.in.channel, in.c}, {out.data.data() + op.out.channel, out.c},
+                    residual ? RowsView{residual->data.data() + op.residual->channel, residual->c} : RowsView{},
+                    static_cast<int>(in.pixels()), op.in.c, op.weights->gamma, op.weights->beta);
+  });
 }
 
 }  // namespace neuflow::model

@@ -7,8 +7,21 @@ void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op) {
   const DeviceLinear& w = *op.weights;
   const View in = r.view(op.in), out = r.view(op.out);
   const int tokens = in.h * in.w;
-  const MatmulParams p{w.out_features, tokens, w.in_features, w.weight.offset, w.in_features, 1, in.offset(), tokens,
-                       1, out.offset(), tokens, 1, w.bias.offset, activation_code(op.act), 1.f};
+  const MatmulParams p{w.out_features,
+                       tokens,
+                       w.in_features,
+                       w.weight.offset,
+                       w.in_features,
+                       1,
+                       in.offset(),
+                       tokens,
+                       1,
+                       out.offset(),
+                       tokens,
+                       1,
+                       w.bias.offset,
+                       activation_code(op.act),
+                       1.f};
   r.dispatch<Shader::matmul>({&r.weights(), in.buffer, out.buffer, nullptr}, p, tiles(tokens, "attention"),
                              tiles(w.out_features, "attention"));
 }

@@ -2,8 +2,8 @@
 // NeuFlow-V2's local correlation, computed from the features directly instead of sampling an
 // all-pairs volume: per pixel, dot products with the 10×10 integer neighbours of
 // floor(p + flow), blended with the shared bilinear weights into the 9×9 window.
+#include "kernels/feature_ops.hpp"
 #include "network_dims.hpp"
-#include "ops/feature_ops.hpp"
 #include "tensor.hpp"
 
 namespace neuflow::model {

@@ -1,4 +1,4 @@
-#include "ops/feature_ops.hpp"
+#include "kernels/feature_ops.hpp"
 
 #include <algorithm>
 #include <stdexcept>
