@@ -32,7 +32,8 @@ class Conv2dOp final : public CpuOp {
     if (whole_ && t.blocked(op.out.tensor)) t.set_layout(op.out.tensor, conv_->output_desc());
     if (!whole_) {
       slice_ = nhwc_desc(out.h, out.w, out.c).submemory_desc({1, op.out.c, out.h, out.w}, {0, op.out.channel, 0, 0});
-      to_slice_ = dnnl::reorder(dnnl::reorder::primitive_desc(cpu_engine(), conv_->output_desc(), cpu_engine(), slice_));
+      to_slice_ =
+          dnnl::reorder(dnnl::reorder::primitive_desc(cpu_engine(), conv_->output_desc(), cpu_engine(), slice_));
     }
     // Only the output of a convolution into a slice is scratch (the tensor's part is copied from
     // it); a whole tensor's is the tensor itself.

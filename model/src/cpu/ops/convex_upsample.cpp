@@ -45,10 +45,9 @@ class ConvexUpsampleOp final : public CpuOp {
     for (int y0 = 0; y0 < h8; y0 += band_rows_) {
       const int rows = std::min(band_rows_, h8 - y0);
       const int pixels = rows * w8;
-      matmul(pass.stream, {features.data.data() + static_cast<std::size_t>(y0) * w8 * features.c, pixels, depth,
-                           features.c},
-             {w.weight.data(), kLogits, depth, depth}, logits, kLogits,
-             {.transpose_b = true, .bias = w.bias.data()});
+      matmul(pass.stream,
+             {features.data.data() + static_cast<std::size_t>(y0) * w8 * features.c, pixels, depth, features.c},
+             {w.weight.data(), kLogits, depth, depth}, logits, kLogits, {.transpose_b = true, .bias = w.bias.data()});
       pass.stream.wait();
       // Softmax over the 9 neighbours of each output pixel: subtract the max (64 output pixels
       // side by side, so the loops vectorize), exp by oneDNN, then normalized weighted sums.

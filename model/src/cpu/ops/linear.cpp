@@ -12,9 +12,7 @@ std::unique_ptr<CpuOp> build_op(const graph::Linear<HostTensor>& op, OpBuild&) {
     const int tokens = static_cast<int>(in.pixels());
     matmul(pass.stream, {in.data.data() + op.in.channel, tokens, op.in.c, in.c},
            {w.weight.data(), w.out_features, w.in_features, w.in_features}, out.data.data() + op.out.channel, out.c,
-           {.transpose_b = true,
-            .bias = w.bias.empty() ? nullptr : w.bias.data(),
-            .gelu = op.act == Activation::gelu});
+           {.transpose_b = true, .bias = w.bias.empty() ? nullptr : w.bias.data(), .gelu = op.act == Activation::gelu});
     pass.stream.wait();
   });
 }
