@@ -94,18 +94,16 @@ int print_arena(const std::string& model_path, int width, int height) {
   std::printf("%-10s %8s %8s %8s %8s\n", "", "direct", "B/px", "winograd", "B/px");
   const NetworkPlan direct(model->weights(), height, width, CpuConvolution::direct);
   const NetworkPlan winograd(model->weights(), height, width, CpuConvolution::winograd);
-  const auto row = [&](const char* name, std::size_t d, std::size_t w) {
+  const auto row = [&](const char* name, double d, double w) {
     std::printf("%-10s %8.1f %8.0f %8.1f %8.0f\n", name, d / 1e6, d / pixels, w / 1e6, w / pixels);
   };
   const NetworkPlan::Memory d = direct.memory(), w = winograd.memory();
-  row("allocation", d.allocation, w.allocation);
-  row("op scratch", d.largest_scratch, w.largest_scratch);
+  row("allocation", static_cast<double>(d.allocation), static_cast<double>(w.allocation));
+  row("op scratch", static_cast<double>(d.largest_scratch), static_cast<double>(w.largest_scratch));
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   int width = 768, height = 432, threads = 2, runs = 10;
   bool arena = false;
   const char* shared_env = std::getenv("NEUFLOW_SHARED_DIR");
@@ -177,4 +175,15 @@ int main(int argc, char** argv) {
                 direct / wino);
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "neuflow-bench-conv: %s\n", e.what());
+    return 70;
+  }
 }

@@ -29,7 +29,8 @@ float naive_corr(const Tensor& f0, const Tensor& f1, const Tensor& flow, int y, 
     for (int c = 0; c < f0.c; ++c) s += static_cast<double>(f0.pixel(y, x)[c]) * f1.pixel(qy, qx)[c];
     return s / std::sqrt(static_cast<double>(f0.c));
   };
-  const double px = x + flow.pixel(y, x)[0] + dx, py = y + flow.pixel(y, x)[1] + dy;
+  const double px = static_cast<float>(x) + flow.pixel(y, x)[0] + static_cast<float>(dx);
+  const double py = static_cast<float>(y) + flow.pixel(y, x)[1] + static_cast<float>(dy);
   const int x0 = static_cast<int>(std::floor(px)), y0 = static_cast<int>(std::floor(py));
   const double ax = px - x0, ay = py - y0;
   return static_cast<float>((1 - ax) * (1 - ay) * volume(y0, x0) + ax * (1 - ay) * volume(y0, x0 + 1) +

@@ -175,6 +175,7 @@ TEST_F(VulkanSession, PipelinedStreamingGivesPushsFlows) {
   const SessionOptions options{.iterations = {1, 2}, .backend = Backend::vulkan};
   FlowSession reference(model_, options);
   std::vector<std::optional<flow::FlowField>> expected;
+  expected.reserve(f.size());
   for (const auto& m : f) expected.push_back(reference.push(view_of(m)));
 
   FlowSession pipe(model_, options);
