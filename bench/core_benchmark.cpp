@@ -233,6 +233,16 @@ void BM_Pair(benchmark::State& state, int width, int height, Variant variant) {
   compare(state, "pair/" + std::to_string(width) + "x" + std::to_string(height), variant);
 }
 
+// Pushes frame i of the sequence; the seconds the push took.
+double timed_push(FlowSession& session, const FrameSequence& frames, std::size_t i) {
+  const cv::Mat frame = frames.at(i);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto f = session.push(view(frame));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  benchmark::DoNotOptimize(f);
+  return seconds;
+}
+
 void BM_Stream(benchmark::State& state, int width, int height, Variant variant) {
   FlowSession session(g_model, options_for(variant));
   const FrameSequence frames(width, height);
@@ -241,14 +251,7 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
   if (variant.backend != neuflow::model::Backend::cpu && !label_gpu_run(state, session, variant)) return;
   double total = 0;
   std::size_t i = 2;
-  for (auto _ : state) {
-    const cv::Mat frame = frames.at(i);
-    const auto t0 = std::chrono::steady_clock::now();
-    auto f = session.push(view(frame));
-    total += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    benchmark::DoNotOptimize(f);
-    ++i;
-  }
+  for (auto _ : state) total += timed_push(session, frames, i++);
   report(state, total / static_cast<double>(state.iterations()),
          neuflow::model::network_cost(height, width).stream_frame());
   compare(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), variant);
@@ -362,11 +365,7 @@ void BM_VulkanStreamStages(benchmark::State& state, int width, int height, Varia
   double host_seconds = 0;
   std::size_t i = 2;
   for (auto _ : state) {
-    const cv::Mat frame = frames.at(i);
-    const auto t0 = std::chrono::steady_clock::now();
-    auto f = session.push(view(frame));
-    host_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    benchmark::DoNotOptimize(f);
+    host_seconds += timed_push(session, frames, i);
     for (const auto& t : session.device_stage_times()) stage_ms[stage_group(t.name)] += t.milliseconds;
     ++i;
   }

@@ -72,9 +72,8 @@ TEST(NetworkGraph, TheFlowPassShowsTheObserverEveryStageInTheReferencesOrder) {
     return std::vector<std::string>{s::corr_iteration(scale, i) + "/0", s::refine_iteration(scale, i) + "_hidden/0",
                                     s::refine_iteration(scale, i) + "_delta/0"};
   };
-  std::vector<std::string> expected{"backbone_s16/0", "backbone_s16/1", "backbone_s8/0", "backbone_s8/1",
-                                    "conv_s8/0",      "cross_attn_s16/0", "cross_attn_s16/1",
-                                    "global_matching_flow/0"};
+  std::vector<std::string> expected{"backbone_s16/0", "backbone_s16/1",   "backbone_s8/0",    "backbone_s8/1",
+                                    "conv_s8/0",      "cross_attn_s16/0", "cross_attn_s16/1", "global_matching_flow/0"};
   for (const auto& n : it(s::scale_s16, 0)) expected.push_back(n);
   for (const char* n : {"merge_s8/0", "merge_s8/1", "context_merge_s8/0"}) expected.emplace_back(n);
   for (int i = 0; i < 2; ++i) {

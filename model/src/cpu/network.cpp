@@ -102,13 +102,8 @@ void NetworkPlan::choose_layouts() {
   std::vector<int> readers(n, 0);
   for (const auto* pass : {&graph_.encode, &graph_.flow}) {
     for (const auto& node : *pass) {
-      std::visit(
-          [&](const auto& o) {
-            o.accesses([&](const graph::Slice& s, graph::Access a) {
-              if (a == graph::Access::read) ++readers[static_cast<std::size_t>(s.tensor)];
-            });
-          },
-          node.op);
+      const graph::Accesses a = std::visit([](const auto& o) { return o.accesses(); }, node.op);
+      for (const graph::Slice& s : a.reads) ++readers[static_cast<std::size_t>(s.tensor)];
     }
   }
   for (const auto& node : graph_.flow) {
@@ -140,8 +135,10 @@ void NetworkPlan::choose_layouts() {
                 return;
               }
             }
-            o.accesses(
-                [&](const graph::Slice& s, graph::Access) { conv_only[static_cast<std::size_t>(s.tensor)] = false; });
+            const graph::Accesses a = o.accesses();
+            for (const auto* slices : {&a.reads, &a.writes}) {
+              for (const graph::Slice& s : *slices) conv_only[static_cast<std::size_t>(s.tensor)] = false;
+            }
           },
           node.op);
     }

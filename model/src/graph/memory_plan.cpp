@@ -63,41 +63,30 @@ LiveRanges live_ranges(const TensorTable& tensors, const std::vector<const OpLis
   for (const OpList<T>* pass : passes) {
     std::fill(open.begin(), open.end(), false);
     for (const Node<T>& node : *pass) {
-      const Op<T>& op = node.op;
       // Reads first: an op that reads and writes a tensor continues its range.
-      std::vector<TensorId> read;
-      std::visit(
-          [&](const auto& o) {
-            o.accesses([&](const Slice& s, Access a) {
-              if (a == Access::read) read.push_back(s.tensor);
-            });
-          },
-          op);
-      for (const TensorId t : read) {
-        const auto i = static_cast<std::size_t>(t);
-        if (!planned(tensors.at(t))) continue;
+      const Accesses a = std::visit([](const auto& o) { return o.accesses(); }, node.op);
+      for (const Slice& r : a.reads) {
+        const auto i = static_cast<std::size_t>(r.tensor);
+        if (!planned(tensors.at(r.tensor))) continue;
         if (!open[i]) {
-          throw std::logic_error("the network graph reads " + tensors.at(t).name +
+          throw std::logic_error("the network graph reads " + tensors.at(r.tensor).name +
                                  " before any op of its pass writes it");
         }
         ranges[i].back().last = index;
       }
-      std::visit(
-          [&](const auto& o) {
-            o.accesses([&](const Slice& s, Access a) {
-              const auto i = static_cast<std::size_t>(s.tensor);
-              if (a != Access::write || !planned(tensors.at(s.tensor))) return;
-              const bool whole = s.channel == 0 && s.c == tensors.at(s.tensor).c;
-              const bool also_read = std::find(read.begin(), read.end(), s.tensor) != read.end();
-              if (!open[i] || (whole && !also_read)) {
-                ranges[i].push_back({index, index});
-                open[i] = true;
-              } else {
-                ranges[i].back().last = index;
-              }
-            });
-          },
-          op);
+      for (const Slice& w : a.writes) {
+        const auto i = static_cast<std::size_t>(w.tensor);
+        if (!planned(tensors.at(w.tensor))) continue;
+        const bool whole = w.channel == 0 && w.c == tensors.at(w.tensor).c;
+        const bool also_read =
+            std::any_of(a.reads.begin(), a.reads.end(), [&](const Slice& r) { return r.tensor == w.tensor; });
+        if (!open[i] || (whole && !also_read)) {
+          ranges[i].push_back({index, index});
+          open[i] = true;
+        } else {
+          ranges[i].back().last = index;
+        }
+      }
       ++index;
     }
   }

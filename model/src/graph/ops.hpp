@@ -16,26 +16,22 @@
 
 namespace neuflow::model::graph {
 
-enum class Access { read, write };
+// What an op reads and writes.
+struct Accesses {
+  std::vector<Slice> reads, writes;
+};
 
 // The pass's input frame, as the network takes it: [3][H][W] in 0..1. Where it comes from (an
 // 8-bit frame, a converted image) is the backend's business.
 struct FrameInput {
   Slice out;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{}, {out}}; }
 };
 
 // 2×2 average pooling.
 struct AvgPool2x {
   Slice in, out;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(in, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{in}, {out}}; }
 };
 
 // out = act(conv(in) + bias (+ addend)); `layer` is the architecture table's name.
@@ -47,12 +43,7 @@ struct Conv2d {
   int stride = 1, pad = 1;
   Activation act = Activation::none;
   std::optional<Slice> addend;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(in, Access::read);
-    if (addend) f(*addend, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return addend ? Accesses{{in, *addend}, {out}} : Accesses{{in}, {out}}; }
 };
 
 // Per token (pixel): out = act(W · in + b).
@@ -62,11 +53,7 @@ struct Linear {
   std::string layer;
   Slice in, out;
   Activation act = Activation::none;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(in, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{in}, {out}}; }
 };
 
 // Attention over all tokens: out[:, i] = Σ_j softmax_j(q[:, i] · k[:, j]) v[:, j] (the scale is
@@ -75,14 +62,7 @@ struct Attention {
   Slice q, k, v, out;
   TensorId scores = -1;
   int block_rows = 1;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(q, Access::read);
-    f(k, Access::read);
-    f(v, Access::read);
-    f({scores, 0, 1}, Access::write);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{q, k, v}, {{scores, 0, 1}, out}}; }
 };
 
 // LayerNorm over each token's channels (+ residual afterwards).
@@ -92,12 +72,7 @@ struct LayerNorm {
   std::string layer;
   Slice in, out;
   std::optional<Slice> residual;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(in, Access::read);
-    if (residual) f(*residual, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return residual ? Accesses{{in, *residual}, {out}} : Accesses{{in}, {out}}; }
 };
 
 // In place: x = x · scale[c] + shift[c] (a folded BatchNorm).
@@ -107,11 +82,7 @@ struct ChannelAffine {
   const T* shift = nullptr;
   std::string layer;
   Slice inout;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(inout, Access::read);
-    f(inout, Access::write);
-  }
+  Accesses accesses() const { return {{inout}, {inout}}; }
 };
 
 // Flow at 1/16 from all-pairs matching: softmax(f0 · f1ᵀ / √c) · grid - grid, in blocks of
@@ -120,15 +91,7 @@ struct GlobalMatching {
   Slice f0, f1, grid, out;
   TensorId scores = -1, correspondence = -1;
   int block_rows = 1;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(f0, Access::read);
-    f(f1, Access::read);
-    f(grid, Access::read);
-    f({scores, 0, 1}, Access::write);
-    f({correspondence, 0, 2}, Access::write);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{f0, f1, grid}, {{scores, 0, 1}, {correspondence, 0, 2}, out}}; }
 };
 
 // Nearest-neighbour upsampling by `factor` (1: a copy), out = scale · (relu ? max(in, 0) : in).
@@ -137,75 +100,43 @@ struct Resample {
   int factor = 1;
   bool relu = false;
   float scale = 1.f;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(in, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{in}, {out}}; }
 };
 
 struct Copy {
   Slice in, out;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(in, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{in}, {out}}; }
 };
 
 struct Zero {
   Slice out;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{}, {out}}; }
 };
 
 // The 9×9 window of f0 · f1 around each pixel displaced by the flow, divided by √c.
 struct LocalCorrelation {
   Slice f0, f1, flow, out;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(f0, Access::read);
-    f(f1, Access::read);
-    f(flow, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{f0, f1, flow}, {out}}; }
 };
 
 // The refinement's step from conv3's output [delta 2, hidden 64]: hidden = clamp(hidden, ±4),
 // flow += delta, the new flow also into flow_copy (the next step's input).
 struct RefineUpdate {
   Slice update, hidden, flow_copy, flow;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(update, Access::read);
-    f(flow, Access::read);
-    f(hidden, Access::write);
-    f(flow_copy, Access::write);
-    f(flow, Access::write);
-  }
+  Accesses accesses() const { return {{update, flow}, {hidden, flow_copy, flow}}; }
 };
 
 // Flow at 1/8 to full size: each output pixel a softmax-weighted 3×3 neighbourhood (the 576
 // mask channels), times 8.
 struct ConvexUpsample {
   Slice mask, flow, out;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(mask, Access::read);
-    f(flow, Access::read);
-    f(out, Access::write);
-  }
+  Accesses accesses() const { return {{mask, flow}, {out}}; }
 };
 
 // The pass's result, handed to the host.
 struct Output {
   Slice flow;
-  template <typename F>
-  void accesses(F&& f) const {
-    f(flow, Access::read);
-  }
+  Accesses accesses() const { return {{flow}, {}}; }
 };
 
 // The end of a named stage (stage_observer.hpp): where the timestamps go, and what an observer
@@ -218,9 +149,10 @@ struct StageEnd {
   };
   std::string name;
   std::vector<Observed> observed;
-  template <typename F>
-  void accesses(F&& f) const {
-    for (const auto& o : observed) f(o.tensor, Access::read);
+  Accesses accesses() const {
+    Accesses a;
+    for (const auto& o : observed) a.reads.push_back(o.tensor);
+    return a;
   }
 };
 

@@ -44,7 +44,10 @@ class Checker {
 
   void check(const Op<T>& op) {
     op_ = &op;
-    std::visit([&](const auto& o) { o.accesses([&](const Slice& s, Access) { inside(s); }); }, op);
+    const Accesses a = std::visit([](const auto& o) { return o.accesses(); }, op);
+    for (const auto* slices : {&a.reads, &a.writes}) {
+      for (const Slice& s : *slices) inside(s);
+    }
     std::visit([&](const auto& o) { check_op(o); }, op);
   }
 

@@ -15,14 +15,7 @@ void ScoreAccumulator::add(const flow::FlowMetrics& pair) {
 Summary ScoreAccumulator::summary() const {
   // The ratios of the pooled counts, as flow::compute_metrics makes them for one field.
   const flow::FlowMetrics m = flow::metrics_from_counts(pooled_);
-  Summary s;
-  s.pairs = pairs_;
-  s.valid_pixels = pooled_.pixels;
-  s.epe = m.epe;
-  s.fl_all = m.fl_all;
-  s.within_1px = m.within_1px;
-  s.within_3px = m.within_3px;
-  s.within_5px = m.within_5px;
+  Summary s{pairs_, pooled_.pixels, m.epe, m.fl_all, m.within_1px, m.within_3px, m.within_5px};
   if (aggregation_ == Aggregation::mean_of_images && images_scored_ > 0) {
     s.epe = image_epe_sum_ / static_cast<double>(images_scored_);
   }

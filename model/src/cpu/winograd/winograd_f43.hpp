@@ -6,14 +6,11 @@
 // points ξ = 6·i + j of a transformed tile are laid out row-major. Each transform is
 // separable: the 1-D form runs over columns, then rows.
 #include "winograd/float8.hpp"
+#include "winograd/tile_sizes.hpp"
 
 namespace neuflow::model::winograd {
 
-struct F43 {
-  static constexpr int kOutputTile = 4;
-  static constexpr int kInputTile = 6;
-  static constexpr int kPoints = kInputTile * kInputTile;
-
+struct F43 : TileSizes<4> {
   // Bᵀ applied to six values at stride `s` of `d`, written at stride `s` of `r`.
   static void input_1d(const Float8* d, Float8* r, int s) {
     const Float8 d0 = d[0], d1 = d[s], d2 = d[2 * s], d3 = d[3 * s], d4 = d[4 * s], d5 = d[5 * s];

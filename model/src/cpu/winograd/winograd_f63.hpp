@@ -7,14 +7,11 @@
 // stays within the error budget (dnnl/conv_op.cpp). The same conventions as winograd_f43.hpp;
 // the forms of the 1-D transforms are those of ncnn's and Lavin's wincnn.
 #include "winograd/float8.hpp"
+#include "winograd/tile_sizes.hpp"
 
 namespace neuflow::model::winograd {
 
-struct F63 {
-  static constexpr int kOutputTile = 6;
-  static constexpr int kInputTile = 8;
-  static constexpr int kPoints = kInputTile * kInputTile;
-
+struct F63 : TileSizes<6> {
   // Bᵀ applied to eight values at stride `s` of `d`, written at stride `s` of `r`.
   static void input_1d(const Float8* d, Float8* r, int s) {
     const Float8 d0 = d[0], d1 = d[s], d2 = d[2 * s], d3 = d[3 * s], d4 = d[4 * s], d5 = d[5 * s], d6 = d[6 * s],

@@ -10,15 +10,14 @@
 #include <string>
 #include <vector>
 
+#include "neuflow/flow/visualize.hpp"
 #include "neuflow/pipeline/frame_rate.hpp"
 
 namespace neuflow::pipeline {
 
-// One decoded frame, rows top to bottom without padding, pixels R, G, B.
-struct RgbFrame {
-  int width = 0;
-  int height = 0;
-  std::vector<std::uint8_t> rgb;       // 3 * width * height
+// One decoded frame: its pixels (rows top to bottom without padding, R, G, B) and where it is
+// in the stream.
+struct RgbFrame : flow::RgbImage {
   std::int64_t number = 0;             // 0-based position in the decoded stream
   std::optional<std::int64_t> pts_ns;  // presentation timestamp, when the stream has one
 };
