@@ -1,4 +1,4 @@
-# toml++ (3.x), which neuflowd reads its config with: Debian 12's libtomlplusplus-dev (a shared
+# toml++ (3.x), which neuflowd reads its config with and `neuflow convert` its folders' records: Debian 12's libtomlplusplus-dev (a shared
 # library, found with pkg-config), or, where it is not packaged (Ubuntu 22.04, JetPack 6), the
 # header-only library from its source tree: -DTOMLPP_INCLUDE_DIR=<tomlplusplus>/include.
 # Defines neuflow::tomlplusplus, or stops with what to do.

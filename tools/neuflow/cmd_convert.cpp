@@ -15,6 +15,7 @@
 #include "convert/inputs.hpp"
 #include "convert/job.hpp"
 #include "convert/progress.hpp"
+#include "fetch_model/hash.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -34,6 +35,7 @@ struct ConvertArgs {
   std::string viz = "none";
   double max_flow = 20;
   bool resume = false;
+  bool overwrite = false;
   std::int64_t max_frames = 0;
   std::string fps;     // --fps N or N/D
   std::string shard;   // --shard K/N
@@ -117,6 +119,28 @@ std::string summary_line(const InputSpec& input, const InputOutcome& outcome) {
   return line;
 }
 
+// What this run makes its flows with. The backend is the one the session opened (auto names
+// where it ran); the model, its content.
+OutputRecord record_of(const ConvertArgs& a, const model::FlowSession& session) {
+  const model::SessionOptions& o = session.options();
+  const std::string& where = session.backend_description();
+  std::string model_sha1;
+  try {
+    model_sha1 = git_blob_sha1_of_file(a.model);
+  } catch (const std::exception& e) {
+    throw CommandError(kExitNoInput, e.what());
+  }
+  return {model_sha1,
+          o.iterations.s16,
+          o.iterations.s8,
+          o.model_width,
+          o.model_height,
+          std::string(model::channel_order_name(o.network_order)),
+          where.substr(0, where.find(' ')),
+          std::string(model::precision_name(o.precision)),
+          a.format};
+}
+
 void run_convert(const ConvertArgs& a) {
   const model::SessionOptions options = session_options(a.session);
   if (a.inputs.empty() && a.pairs.empty())
@@ -145,6 +169,8 @@ void run_convert(const ConvertArgs& a) {
   settings.viz = a.viz == "png" ? VizMode::png : a.viz == "video" ? VizMode::video : VizMode::none;
   settings.max_flow = a.max_flow;
   settings.resume = a.resume;
+  settings.overwrite = a.overwrite;
+  settings.record = record_of(a, session);
   settings.max_frames = a.max_frames;
   settings.frames = frames;
   settings.image_rate = image_rate;
@@ -220,7 +246,11 @@ void register_convert(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sub->add_flag("--resume", args->resume,
-                "Keep flow files that already exist and read back complete at the frames' size; compute the rest");
+                "Keep flow files that already exist and read back complete at the frames' size; compute the rest. "
+                "A folder whose settings.toml records other settings (model, iterations, model size, channel order, "
+                "backend, precision, format) is refused (exit 64)");
+  sub->add_flag("--overwrite", args->overwrite,
+                "With --resume: recompute a folder made with other settings instead of refusing it");
   sub->add_option("--max-frames", args->max_frames, "Only the first N frames of each input (N-1 pairs); 0: all")
       ->capture_default_str()
       ->check(CLI::Validator(

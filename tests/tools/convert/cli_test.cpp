@@ -242,6 +242,59 @@ TEST_F(ConvertCli, ResumeRecomputesOnlyMissingOrIncompleteFlows) {
   EXPECT_EQ(read_csv(out / "index.csv").size(), 5u) << "the index lists kept pairs too";
 }
 
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Flows fed RGB are not resumed feeding BGR: the folder is refused (64), naming the difference,
+// its flows untouched; --overwrite recomputes them and records the new settings.
+TEST_F(ConvertCli, ResumeWithOtherSettingsIsRefusedNamingThemUnlessOverwrite) {
+  TempDir dir;
+  make_frames(dir / "seq", {"f1.png", "f2.png", "f3.png"});
+  const fs::path out = dir / "out" / "seq";
+  ASSERT_EQ(convert(dir / "out", {(dir / "seq").string()}).exit_code, 0);
+  const std::string record = read_text(out / "settings.toml");
+  EXPECT_NE(record.find("iters_s8 = 1"), std::string::npos) << record;
+  EXPECT_NE(record.find("format = 'flo'"), std::string::npos) << record;
+  EXPECT_NE(record.find("backend = 'cpu'"), std::string::npos) << record;
+  const auto sha = record.find("model_sha1 = '");
+  ASSERT_NE(sha, std::string::npos) << record;
+  EXPECT_EQ(record.find('\'', sha + 14), sha + 14 + 40) << "a git blob SHA-1: " << record;
+  const auto kept_time = fs::last_write_time(out / "f1.flo");
+
+  auto args = std::vector<std::string>{(dir / "seq").string(), "--resume", "--channel-order", "bgr"};
+  const auto refused = convert(dir / "out", args);
+  EXPECT_EQ(refused.exit_code, kExitUsage) << refused.output;
+  EXPECT_NE(refused.output.find("--channel-order rgb (now bgr)"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("--overwrite"), std::string::npos) << refused.output;
+  EXPECT_EQ(fs::last_write_time(out / "f1.flo"), kept_time) << "a refused folder was written to";
+  EXPECT_EQ(read_text(out / "settings.toml"), record);
+
+  args.emplace_back("--overwrite");
+  const auto recomputed = convert(dir / "out", args);
+  ASSERT_EQ(recomputed.exit_code, 0) << recomputed.output;
+  EXPECT_NE(recomputed.output.find("2 pairs (2 written, 0 skipped)"), std::string::npos) << recomputed.output;
+  EXPECT_NE(read_text(out / "settings.toml").find("channel_order = 'bgr'"), std::string::npos);
+
+  // The same settings again: resumed.
+  args.pop_back();
+  const auto resumed = convert(dir / "out", args);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("2 pairs (0 written, 2 skipped)"), std::string::npos) << resumed.output;
+}
+
+TEST_F(ConvertCli, AFolderRecordThatIsNotOneIsNamed) {
+  TempDir dir;
+  make_frames(dir / "seq", {"f1.png", "f2.png"});
+  ASSERT_EQ(convert(dir / "out", {(dir / "seq").string()}).exit_code, 0);
+  std::ofstream(dir / "out" / "seq" / "settings.toml") << "iters_s8 = [\n";
+  const auto result = convert(dir / "out", {(dir / "seq").string(), "--resume"});
+  EXPECT_EQ(result.exit_code, kExitDataError) << result.output;
+  EXPECT_NE(result.output.find("settings.toml"), std::string::npos) << result.output;
+  EXPECT_EQ(convert(dir / "out", {(dir / "seq").string(), "--resume", "--overwrite"}).exit_code, 0);
+}
+
 TEST_F(ConvertCli, ResumeRebuildsTheVideoFromKeptFlows) {
   TempDir dir;
   make_frames(dir / "seq", {"f1.png", "f2.png", "f3.png", "f4.png"});
@@ -397,7 +450,7 @@ TEST_F(ConvertCli, ShardsTogetherWriteWhatOneRunWrites) {
     ASSERT_EQ(result.exit_code, 0) << shard << ": " << result.output;
   }
   const auto whole = tree(dir / "whole"), sharded = tree(dir / "sharded");
-  EXPECT_EQ(whole.size(), 8u);  // 4 inputs × (1 flow + index.csv)
+  EXPECT_EQ(whole.size(), 12u);  // 4 inputs × (1 flow + index.csv + settings.toml)
   EXPECT_TRUE(whole.count("a_2/0.flo")) << "the second 'a' is a_2";
   EXPECT_TRUE(whole == sharded) << "the shards wrote other files than the whole run";
 
@@ -419,7 +472,7 @@ TEST_F(ConvertCli, FrameRangesTogetherWriteWhatOneRunWrites) {
     ASSERT_EQ(result.exit_code, 0) << range << ": " << result.output;
   }
   auto whole = tree(dir / "whole"), ranges = tree(dir / "ranges");
-  EXPECT_EQ(whole.size(), 6u);  // 5 flows + index.csv
+  EXPECT_EQ(whole.size(), 7u);  // 5 flows + index.csv + settings.toml
   EXPECT_TRUE(ranges.count("ball/index.0-2.csv") && ranges.count("ball/index.2-4.csv") &&
               ranges.count("ball/index.4-end.csv"));
   const auto whole_index = read_csv(dir / "whole" / "ball" / "index.csv");

@@ -112,11 +112,35 @@ class Conversion {
   std::unique_ptr<FrameSource> frames_;
   std::unique_ptr<pipeline::VideoEncoder> video_;
   bool session_holds_from_ = false;  // the session's last frame is the pair's first one
+  bool resume_ = false;              // keep the folder's complete flows
 };
+
+// --resume keeps a folder's flows only when its record says they were made as this run makes
+// them; otherwise it refuses the folder, or with --overwrite recomputes it.
+bool may_resume(const fs::path& dir, const ConvertSettings& settings) {
+  if (!settings.resume) return false;
+  std::optional<OutputRecord> was;
+  try {
+    was = read_record(dir);
+  } catch (const InputError&) {
+    if (settings.overwrite) return false;
+    throw;
+  }
+  if (!was) return true;  // written before folders had records
+  const std::vector<std::string> differences = record_differences(*was, settings.record);
+  if (differences.empty()) return true;
+  if (settings.overwrite) return false;
+  std::string list;
+  for (const auto& d : differences) list += (list.empty() ? "" : ", ") + d;
+  throw InputError(kExitUsage, dir.string() + ": its flows were made with other settings: " + list +
+                                   "; resume with those, or add --overwrite to recompute them");
+}
 
 void Conversion::run(InputOutcome& outcome) {
   frames_ = open_frames(input_);
   create_folder(dir_);
+  resume_ = may_resume(dir_, settings_);
+  write_record(dir_, settings_.record);
   if (settings_.viz == VizMode::png) create_folder(dir_ / "viz");
   session_.reset();
 
@@ -175,7 +199,7 @@ void Conversion::convert_pair(const Frame& from, const Frame& to, InputOutcome& 
   const fs::path png_path = dir_ / "viz" / (from.output_stem + ".png");
 
   std::optional<flow::FlowField> field;
-  if (settings_.resume) field = read_complete_flow(flow_path, width, height);
+  if (resume_) field = read_complete_flow(flow_path, width, height);
   const bool skipped = field.has_value();
   if (skipped) {
     ++outcome.pairs_skipped;

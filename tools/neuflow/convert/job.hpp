@@ -10,6 +10,7 @@
 //   viz/<stem>.png         its colour rendering (--viz png)
 //   viz.mp4                all renderings as an H.264 video (--viz video)
 //   index.csv              one row per pair (see convert/index.hpp)
+//   settings.toml          what made the flows (convert/output_record.hpp)
 // With --frames A:B the index and the video are index.A-B.csv and viz.A-B.mp4, so jobs that
 // take other ranges of the same input write beside each other.
 #include <cstdint>
@@ -19,6 +20,7 @@
 
 #include "convert/input_error.hpp"
 #include "convert/inputs.hpp"
+#include "convert/output_record.hpp"
 #include "convert/progress.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -41,8 +43,11 @@ struct ConvertSettings {
   std::filesystem::path output_dir;
   flow::FlowFormat format = flow::FlowFormat::flo;
   VizMode viz = VizMode::none;
-  double max_flow = 20;              // px at full saturation, fixed so colours mean the same in every frame
-  bool resume = false;               // keep flow files that exist and read back at the right size
+  double max_flow = 20;  // px at full saturation, fixed so colours mean the same in every frame
+  bool resume = false;   // keep flow files that exist and read back at the right size
+  // With resume: recompute a folder made with other settings instead of refusing it.
+  bool overwrite = false;
+  OutputRecord record;               // what this run makes its flows with, written into each folder
   std::int64_t max_frames = 0;       // 0: every frame; else only the first max_frames of each input
   std::optional<FrameRange> frames;  // --frames A:B: one range of each input's pairs
   // The rate of viz.mp4 for images (a video keeps its own): unset, the rate the file names'

@@ -1,0 +1,133 @@
+#include "convert/output_record.hpp"
+
+#include <toml++/toml.h>
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <stdexcept>
+#include <system_error>
+#include <type_traits>
+
+#include "common/exit_codes.hpp"
+#include "convert/input_error.hpp"
+
+namespace neuflow::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Each field once: its key in the file and the option that sets it.
+struct Field {
+  const char* key;
+  const char* option;
+  std::function<std::string(const OutputRecord&)> text;
+  std::function<void(OutputRecord&, const toml::node&)> read;
+  std::function<void(toml::table&, const OutputRecord&)> write;
+};
+
+template <typename T>
+Field field(const char* key, const char* option, T OutputRecord::*member) {
+  Field f{key, option, nullptr, nullptr, nullptr};
+  f.text = [member](const OutputRecord& r) {
+    if constexpr (std::is_same_v<T, int>) {
+      return std::to_string(r.*member);
+    } else {
+      return r.*member;
+    }
+  };
+  f.read = [member, key](OutputRecord& r, const toml::node& n) {
+    if constexpr (std::is_same_v<T, int>) {
+      const auto v = n.value<std::int64_t>();
+      if (!v) throw std::invalid_argument(std::string(key) + " is not a number");
+      r.*member = static_cast<int>(*v);
+    } else {
+      const auto v = n.value<std::string>();
+      if (!v) throw std::invalid_argument(std::string(key) + " is not a string");
+      r.*member = *v;
+    }
+  };
+  f.write = [member, key](toml::table& t, const OutputRecord& r) {
+    if constexpr (std::is_same_v<T, int>) {
+      t.insert(key, static_cast<std::int64_t>(r.*member));
+    } else {
+      t.insert(key, r.*member);
+    }
+  };
+  return f;
+}
+
+const std::vector<Field>& fields() {
+  static const std::vector<Field> all{
+      field("model_sha1", "--model (its git blob SHA-1)", &OutputRecord::model_sha1),
+      field("iters_s16", "--iters-s16", &OutputRecord::iters_s16),
+      field("iters_s8", "--iters-s8", &OutputRecord::iters_s8),
+      field("model_width", "--model-width", &OutputRecord::model_width),
+      field("model_height", "--model-height", &OutputRecord::model_height),
+      field("channel_order", "--channel-order", &OutputRecord::channel_order),
+      field("backend", "--backend", &OutputRecord::backend),
+      field("precision", "--precision", &OutputRecord::precision),
+      field("format", "--format", &OutputRecord::format),
+  };
+  return all;
+}
+
+}  // namespace
+
+fs::path record_path(const fs::path& folder) { return folder / "settings.toml"; }
+
+std::optional<OutputRecord> read_record(const fs::path& folder) {
+  const fs::path path = record_path(folder);
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return std::nullopt;
+  try {
+    const toml::table table = toml::parse_file(path.string());
+    OutputRecord r;
+    for (const Field& f : fields()) {
+      const toml::node* n = table.get(f.key);
+      if (!n) throw std::invalid_argument(std::string("no ") + f.key);
+      f.read(r, *n);
+    }
+    return r;
+  } catch (const toml::parse_error& e) {
+    throw InputError(kExitDataError, path.string() + ": not a record of the settings a folder was made with: " +
+                                         std::string(e.description()) + " (delete it, or give --overwrite)");
+  } catch (const std::invalid_argument& e) {
+    throw InputError(kExitDataError, path.string() + ": not a record of the settings a folder was made with: " +
+                                         e.what() + " (delete it, or give --overwrite)");
+  }
+}
+
+void write_record(const fs::path& folder, const OutputRecord& record) {
+  const fs::path path = record_path(folder);
+  const fs::path temporary = path.string() + ".partial-" + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary);
+    out << "# What made the flows in this folder (neuflow convert). `--resume` refuses to add\n"
+           "# flows made with other settings to them; `--resume --overwrite` recomputes them.\n";
+    toml::table table;
+    for (const Field& f : fields()) f.write(table, record);
+    out << table << "\n";
+    if (!out.flush()) throw InputError(kExitCantCreate, temporary.string() + ": cannot write the folder's record");
+  }
+  std::error_code ec;
+  fs::rename(temporary, path, ec);
+  if (ec) {
+    fs::remove(temporary, ec);
+    throw InputError(kExitCantCreate, path.string() + ": cannot write the folder's record");
+  }
+}
+
+std::vector<std::string> record_differences(const OutputRecord& was, const OutputRecord& now) {
+  std::vector<std::string> out;
+  for (const Field& f : fields()) {
+    const std::string a = f.text(was), b = f.text(now);
+    if (a != b) out.push_back(std::string(f.option) + " " + a + " (now " + b + ")");
+  }
+  return out;
+}
+
+}  // namespace neuflow::cli
