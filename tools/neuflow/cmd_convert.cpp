@@ -13,6 +13,7 @@
 #include "commands.hpp"
 #include "common/session_options.hpp"
 #include "convert/inputs.hpp"
+#include "convert/interruption.hpp"
 #include "convert/job.hpp"
 #include "convert/progress.hpp"
 #include "fetch_model/hash.hpp"
@@ -119,6 +120,17 @@ std::string summary_line(const InputSpec& input, const InputOutcome& outcome) {
   return line;
 }
 
+// "interrupted: 7 of 19 pairs of IN written (2 inputs not started); run again with --resume",
+// with the shell's exit code for the signal (130 for Ctrl-C).
+CommandError interrupted(const InputSpec& input, const InputOutcome& outcome, std::size_t not_started) {
+  const std::int64_t done = outcome.pairs_written + outcome.pairs_skipped;
+  std::string text = "interrupted: " + std::to_string(done) +
+                     (outcome.total_pairs ? " of " + std::to_string(*outcome.total_pairs) : std::string()) +
+                     " pairs of " + input.label + " written";
+  if (not_started > 0) text += " (" + std::to_string(not_started) + " more inputs not started)";
+  return CommandError(128 + interruption_signal(), text + "; run again with --resume");
+}
+
 // What this run makes its flows with. The backend is the one the session opened (auto names
 // where it ran); the model, its content.
 OutputRecord record_of(const ConvertArgs& a, const model::FlowSession& session) {
@@ -193,11 +205,13 @@ void run_convert(const ConvertArgs& a) {
     return;
   }
   std::vector<InputOutcome> outcomes;
+  const InterruptionHandler interruption;
   for (const auto& input : inputs) {
     outcomes.push_back(convert_input(input, session, settings, progress));
     report_late_fallback(session, "convert", announced);
     // Said at once, so a long batch does not hide an early failure until the end.
     if (outcomes.back().error) progress.print(failure_text(input, *outcomes.back().error));
+    if (outcomes.back().interrupted) throw interrupted(input, outcomes.back(), inputs.size() - outcomes.size());
   }
 
   std::size_t failed = 0;

@@ -3,18 +3,22 @@
 // run in this process.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "common/exit_codes.hpp"
@@ -293,6 +297,74 @@ TEST_F(ConvertCli, AFolderRecordThatIsNotOneIsNamed) {
   EXPECT_EQ(result.exit_code, kExitDataError) << result.output;
   EXPECT_NE(result.output.find("settings.toml"), std::string::npos) << result.output;
   EXPECT_EQ(convert(dir / "out", {(dir / "seq").string(), "--resume", "--overwrite"}).exit_code, 0);
+}
+
+// A process that has ended: its id names no running process.
+pid_t ended_process() {
+  const pid_t pid = ::fork();
+  if (pid == 0) ::_exit(0);
+  ::waitpid(pid, nullptr, 0);
+  return pid;
+}
+
+// Ctrl-C: the run stops after its current pair with 130, saying how to go on; the index lists
+// every flow written, no partial file is left, and --resume removes what an earlier killed run
+// left and finishes the rest.
+TEST_F(ConvertCli, InterruptedRunLeavesACompleteIndexAndResumes) {
+  TempDir dir;
+  std::vector<std::string> names;
+  for (int i = 0; i < 40; ++i) {
+    names.push_back(std::to_string(100 + i) + ".png");
+    make_frames(dir / "seq", {names.back()}, 160, 96);  // the first camera frame, 40 times
+  }
+  const fs::path out = dir / "out" / "seq", log = dir / "log.txt";
+  auto args = convert_args(dir / "out");
+  args.insert(args.end(), {(dir / "seq").string(), "--viz", "video"});
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(NEUFLOW_BIN)};
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::FILE* f = std::freopen(log.c_str(), "w", stderr);
+    if (f) ::dup2(::fileno(stderr), STDOUT_FILENO);
+    ::execv(NEUFLOW_BIN, argv.data());
+    ::_exit(127);
+  }
+  const auto started = std::chrono::steady_clock::now();
+  while (!fs::exists(out / "100.flo") && std::chrono::steady_clock::now() - started < std::chrono::seconds(120)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const std::string said = read_text(log);
+  ASSERT_TRUE(WIFEXITED(status)) << said;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << said;
+  EXPECT_NE(said.find("interrupted: "), std::string::npos) << said;
+  EXPECT_NE(said.find(" of 39 pairs of "), std::string::npos) << said;
+  EXPECT_NE(said.find("run again with --resume"), std::string::npos) << said;
+  std::size_t flows = 0;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    flows += entry.path().extension() == ".flo";
+    EXPECT_EQ(name.find(".partial-"), std::string::npos) << name << " left behind";
+    EXPECT_NE(name, "viz.mp4") << "the video of an interrupted run";
+  }
+  EXPECT_GT(flows, 0u);
+  EXPECT_LT(flows, 39u) << "the run ended before it was interrupted";
+  EXPECT_EQ(read_csv(out / "index.csv").size(), flows + 1) << "the index lists each flow written";
+
+  const fs::path stale = out / (".viz.mp4.partial-" + std::to_string(ended_process()) + "-0");
+  std::ofstream(stale) << "left by a killed run";
+  args.emplace_back("--resume");
+  const auto resumed = run_neuflow(args);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("39 pairs (" + std::to_string(39 - flows) + " written, " + std::to_string(flows) +
+                                " skipped)"),
+            std::string::npos)
+      << resumed.output;
+  EXPECT_FALSE(fs::exists(stale)) << "--resume left an ended run's partial video";
+  EXPECT_TRUE(fs::exists(out / "viz.mp4"));
 }
 
 TEST_F(ConvertCli, ResumeRebuildsTheVideoFromKeptFlows) {

@@ -12,6 +12,7 @@
 #include "common/exit_codes.hpp"
 #include "convert/frames.hpp"
 #include "convert/index.hpp"
+#include "convert/interruption.hpp"
 #include "neuflow/flow/errors.hpp"
 #include "neuflow/flow/visualize.hpp"
 #include "neuflow/pipeline/pipeline_error.hpp"
@@ -139,6 +140,7 @@ bool may_resume(const fs::path& dir, const ConvertSettings& settings) {
 void Conversion::run(InputOutcome& outcome) {
   frames_ = open_frames(input_);
   create_folder(dir_);
+  if (settings_.resume) remove_stale_partials(dir_);
   resume_ = may_resume(dir_, settings_);
   write_record(dir_, settings_.record);
   if (settings_.viz == VizMode::png) create_folder(dir_ / "viz");
@@ -172,7 +174,12 @@ void Conversion::run(InputOutcome& outcome) {
                                          settings_.frames->suffix() + " starts after its last");
   }
   progress_.set_total(total_pairs());  // a video's length is known once it plays
+  outcome.total_pairs = total_pairs();
   while ((settings_.max_frames == 0 || frames_read < settings_.max_frames) && (!end || frames_read <= *end)) {
+    if (interruption_signal() != 0) {
+      outcome.interrupted = true;
+      return;
+    }
     std::optional<Frame> to = frames_->next();
     if (!to) break;
     ++frames_read;
@@ -277,7 +284,11 @@ InputOutcome convert_input(const InputSpec& input, model::FlowSession& session, 
   };
   try {
     conversion.run(outcome);
-    conversion.finish_outputs();
+    if (outcome.interrupted) {
+      if (conversion.has_rows()) conversion.write_index();
+    } else {
+      conversion.finish_outputs();
+    }
   } catch (const InputError& e) {
     record(e);
   } catch (const flow::FlowFileError& e) {

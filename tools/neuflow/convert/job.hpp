@@ -56,15 +56,18 @@ struct ConvertSettings {
 };
 
 struct InputOutcome {
-  std::filesystem::path output;    // the input's output folder
-  std::int64_t pairs_written = 0;  // flows computed and written
-  std::int64_t pairs_skipped = 0;  // flows kept from an earlier run (--resume)
+  std::filesystem::path output;             // the input's output folder
+  std::int64_t pairs_written = 0;           // flows computed and written
+  std::int64_t pairs_skipped = 0;           // flows kept from an earlier run (--resume)
+  std::optional<std::int64_t> total_pairs;  // the input's pairs (its range's), where known
+  bool interrupted = false;                 // stopped by a signal after its last complete pair (interruption.hpp)
   double seconds = 0;
   std::optional<InputError> error;
 };
 
 // Never throws for a problem with the input or its outputs: that ends up in error, after
-// whatever could be written (and the index of it) has been written.
+// whatever could be written (and the index of it) has been written. Interrupted, it writes the
+// index of the complete pairs and drops the video.
 InputOutcome convert_input(const InputSpec& input, model::FlowSession& session, const ConvertSettings& settings,
                            Progress& progress);
 
