@@ -3,9 +3,14 @@
 // plus the shipped configs (config/*.toml) and tests/fuzz/regressions/<harness>/*. Every
 // generated seed is read back and must be accepted, so a format change that made them useless
 // fails here (ctest fuzz_seeds) rather than silently weakening the fuzzing.
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <functional>
@@ -23,6 +28,7 @@
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/flow/kitti_png_format.hpp"
 #include "neuflow/flow/npy_format.hpp"
+#include "neuflow/flow_ring.hpp"
 #include "neuflow/model/checkpoint.hpp"
 
 namespace fs = std::filesystem;
@@ -198,6 +204,82 @@ void copy_seeds(const fs::path& from, const fs::path& out, const std::string& ha
   }
 }
 
+// ---- the sinks' and the daemon's small formats -----------------------------------------
+
+void write_text(const fs::path& path, const std::string& text) { neuflow::test::write_file(path, text); }
+
+// A live ring of 3 slots with 4×2 flows, 4 published (slot 1 holds flow 4, the others 2 and 3),
+// as the shm sink writes it (docs/shm-ring.md).
+std::string ring_segment(std::uint32_t slots, std::uint64_t published) {
+  namespace r = neuflow::ring;
+  constexpr std::uint32_t width = 4, height = 2;
+  const std::uint64_t data_bytes = std::uint64_t{width} * height * 2 * sizeof(float);
+  const std::uint64_t stride = (sizeof(r::SlotHeader) + data_bytes + 7) / 8 * 8;
+  std::string segment(sizeof(r::RingHeader) + slots * stride, '\0');
+  r::RingHeader h{};
+  std::memcpy(h.magic, "NFLOWRNG", 8);
+  h.version = r::kLayoutVersion;
+  h.header_size = sizeof(r::RingHeader);
+  h.slot_count = slots;
+  h.slot_header_size = sizeof(r::SlotHeader);
+  h.slot_stride = stride;
+  h.grid_width = width;
+  h.grid_height = height;
+  h.value_layout = r::kValueLayoutF32UV;
+  h.state = static_cast<std::uint32_t>(r::SegmentState::live);
+  h.generation = 7;
+  h.flows_published = published;
+  h.segment_size = segment.size();
+  h.data_bytes = data_bytes;
+  std::memcpy(segment.data(), &h, sizeof h);
+  for (std::uint64_t n = published > slots ? published - slots + 1 : 1; n <= published; ++n) {
+    std::vector<float> uv(width * height * 2);
+    for (std::size_t i = 0; i < uv.size(); ++i) uv[i] = static_cast<float>(n) + 0.25f * static_cast<float>(i);
+    r::SlotHeader slot{};
+    slot.sequence = 2 * n;
+    slot.from_frame = n - 1;
+    slot.to_frame = n;
+    slot.from_pts_ns = r::kNoTimestamp;
+    slot.to_pts_ns = r::kNoTimestamp;
+    slot.grid_width = width;
+    slot.grid_height = height;
+    slot.frame_width = 64;
+    slot.frame_height = 32;
+    slot.model_width = 64;
+    slot.model_height = 32;
+    slot.iters_s16 = 1;
+    slot.iters_s8 = 8;
+    slot.data_bytes = data_bytes;
+    slot.crc32 = r::crc32(uv.data(), data_bytes);
+    char* at = segment.data() + sizeof(r::RingHeader) + ((n - 1) % slots) * stride;
+    std::memcpy(at, &slot, sizeof slot);
+    std::memcpy(at + sizeof(r::SlotHeader), uv.data(), data_bytes);
+  }
+  return segment;
+}
+
+void write_sink_seeds(const fs::path& out) {
+  write_text(seed_path(out, "ring_reader", "live.ring"), ring_segment(3, 4));
+  write_text(seed_path(out, "ring_reader", "empty.ring"), ring_segment(2, 0));
+  write_text(seed_path(out, "flow_index", "index.csv"),
+             "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source\n"
+             "0,0,1,0,33333333,flow_00000.flo,,\n"
+             "1,1,2,33333333,66666666,flow_00001.flo,,\n");
+  write_text(seed_path(out, "flow_index", "quoted.csv"),
+             "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source\r\n"
+             "0,0,1,,,\"a,b.flo\",\"x \"\"1\"\".png\",\"line\nbreak.png\"\r\n");
+  write_text(seed_path(out, "retention", "padded.txt"),
+             "flow_%05d.flo\nflow_00001.flo\nflow_00042.flo\nflow_7.flo\nflow_-0005.flo\nflow_123456789012.flo\n");
+  write_text(seed_path(out, "retention", "plain.txt"), "f%d.npy\nf0.npy\nf12.npy\nf012.npy\nf+1.npy\nindex.csv\n");
+  write_text(seed_path(out, "retention", "percent.txt"), "%%_%3d.png\n%_  7.png\n%_ 17.png\n%_017.png\n");
+  const std::pair<const char*, const char*> values[] = {
+      {"name.txt", "front-camera_1"},   {"host.txt", "127.0.0.1:8554"}, {"ipv6.txt", "[::1]:5000"},
+      {"shm.txt", "/neuflow-front"},    {"mode.txt", "0640"},           {"mount.txt", "/cameras/front"},
+      {"pattern.txt", "flow_%05d.flo"}, {"rate.txt", "30000/1001"},     {"percent.txt", "100%%_%d.mp4"},
+  };
+  for (const auto& [name, text] : values) write_text(seed_path(out, "config_values", name), text);
+}
+
 // ---- checks -----------------------------------------------------------------------------
 
 // Every generated seed must be accepted: returns the number refused (and says which).
@@ -230,6 +312,30 @@ int check_seeds(const fs::path& out) {
     neuflow::model::load_checkpoint(zip);
   });
   fs::remove(out / "checkpoint_pickle.check.pth");
+  // A ring seed opens, and its newest flow reads back whole with a matching checksum.
+  check("ring_reader", [](const fs::path& p) {
+    const std::string name = "/neuflow-fuzz-seed-" + std::to_string(::getpid());
+    const std::string bytes = neuflow::test::read_file(p);
+    const int fd = ::shm_open(name.c_str(), O_CREAT | O_RDWR | O_TRUNC, 0600);
+    if (fd < 0 || ::ftruncate(fd, static_cast<off_t>(bytes.size())) != 0 ||
+        ::pwrite(fd, bytes.data(), bytes.size(), 0) != static_cast<ssize_t>(bytes.size())) {
+      throw std::runtime_error("cannot write a shared-memory segment");
+    }
+    ::close(fd);
+    try {
+      const neuflow::ring::FlowRingReader reader(name);
+      std::vector<float> uv(reader.values_per_flow());
+      neuflow::ring::FlowInfo info;
+      const auto status = reader.latest(uv, info);
+      if (reader.published() > 0 && (status != neuflow::ring::ReadStatus::ok || !neuflow::ring::verify(uv, info))) {
+        throw std::runtime_error("its newest flow does not read back");
+      }
+    } catch (...) {
+      ::shm_unlink(name.c_str());
+      throw;
+    }
+    ::shm_unlink(name.c_str());
+  });
   // The shipped configs must load on the file alone; the regression inputs are refused.
   check(
       "config",
@@ -251,13 +357,16 @@ int main(int argc, char** argv) {
   }
   const fs::path out = argv[1];
   try {
-    const std::vector<std::string> harnesses = {"flo", "npy", "kitti_png", "checkpoint", "checkpoint_pickle", "config"};
+    const std::vector<std::string> harnesses = {
+        "flo",    "npy",           "kitti_png",   "checkpoint", "checkpoint_pickle",
+        "config", "config_values", "ring_reader", "flow_index", "retention"};
     for (const auto& harness : harnesses) {
       fs::remove_all(out / harness);
       fs::create_directories(out / harness);
     }
     write_flow_seeds(out);
     write_checkpoint_seeds(out);
+    write_sink_seeds(out);
     for (const auto& entry : fs::directory_iterator(NEUFLOW_CONFIG_DIR)) {
       if (entry.path().extension() == ".toml") {
         fs::copy_file(entry.path(), seed_path(out, "config", entry.path().filename().string()));

@@ -13,7 +13,7 @@
 # (default 2048). See tests/fuzz/README.md.
 set -uo pipefail
 
-all_harnesses=(flo npy kitti_png checkpoint checkpoint_pickle config)
+all_harnesses=(flo npy kitti_png checkpoint checkpoint_pickle config config_values ring_reader flow_index retention)
 seconds=${1:-60}
 (( $# )) && shift
 harnesses=("$@")

@@ -18,7 +18,8 @@ volatile std::sig_atomic_t g_signal = 0;
 
 extern "C" void on_signal(int signal) { g_signal = signal; }
 
-struct sigaction g_previous_int {}, g_previous_term{};
+struct sigaction g_previous_int {
+}, g_previous_term{};
 
 // The writer's process id in a temporary file's name: the digits after ".partial-".
 pid_t writer_of(const std::string& name) {
