@@ -50,6 +50,18 @@
 
 namespace {
 
+constexpr const char* kUsage =
+    "neuflow-bench-core: the CPU's (and with --backend vulkan the GPU's) pair, stream and stage times, against the "
+    "sgemm peak\n"
+    "  --model CKPT          checkpoint (default: $NEUFLOW_MODEL, else the shared fixture's random weights)\n"
+    "  --frames DIR          frames to push (default: the shared fixture's camera sequence)\n"
+    "  --threads N           OpenMP threads (default: 2)\n"
+    "  --sizes WxH[,WxH...]  model sizes (default: 320x256,512x384,768x432,1024x448)\n"
+    "  --backend cpu|vulkan  vulkan also runs the CPU, to compare\n"
+    "  --device N            the Vulkan device (`neuflow devices`)\n"
+    "  --precision fp32|fp16|fp32,fp16   the GPU's precisions\n"
+    "Google Benchmark's flags:\n";
+
 using neuflow::model::FlowModel;
 using neuflow::model::FlowSession;
 using neuflow::model::ImageView;
@@ -428,7 +440,14 @@ int main(int argc, char** argv) {
   const char* shared_env = std::getenv("NEUFLOW_SHARED_DIR");
   const std::filesystem::path shared = shared_env && *shared_env ? shared_env : NEUFLOW_DEFAULT_SHARED_DIR;
   g_config.model = shared / "fixtures/neuflow-v2-seed0/checkpoint.pth";
+  if (const char* env = std::getenv("NEUFLOW_MODEL"); env && *env) g_config.model = env;
   g_config.frames = shared / "fixtures/frames";
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
+      std::printf("%s", kUsage);  // then Google Benchmark's own flags
+      break;
+    }
+  }
   std::string value;
   if (take_option(argc, argv, "--model", value)) g_config.model = value;
   if (take_option(argc, argv, "--frames", value)) g_config.frames = value;

@@ -35,8 +35,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const int n = std::snprintf(name, sizeof name, pattern.c_str(), 2147483647);
 #pragma GCC diagnostic pop
       if (n < 0 || static_cast<std::size_t>(n) > pattern.size() + d::kMaxIndexWidth + 1) {
-        neuflow::fuzz::invariant_failed("config_values", "pattern '" + pattern + "' gives a name of " +
-                                                             std::to_string(n) + " characters");
+        neuflow::fuzz::invariant_failed(
+            "config_values", "pattern '" + pattern + "' gives a name of " + std::to_string(n) + " characters");
       }
     }
   } catch (...) {

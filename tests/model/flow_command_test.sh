@@ -68,4 +68,22 @@ grep -q "model-width: expected a multiple of 16" "$out/err" || fail "unclear mod
 "$neuflow" flow -m "$fixture/checkpoint.pth" --size 160 "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo" \
   2>"$out/err"
 [ $? -eq 64 ] && grep -q "WIDTHxHEIGHT" "$out/err" || fail "--size without a height must say WIDTHxHEIGHT"
+# Without --model: $NEUFLOW_MODEL, else models/neuflow_mixed.pth in the working folder, each said
+# on stderr; with neither, a usage error naming all three.
+frames=("$(cd "$fixture" && pwd)/frame0.png" "$(cd "$fixture" && pwd)/frame1.png")
+checkpoint=$(cd "$fixture" && pwd)/checkpoint.pth
+mkdir -p "$out/cwd/models"
+(cd "$out/cwd" && env -u NEUFLOW_MODEL "$neuflow" flow --iters-s8 1 "${frames[@]}" "$out/x.flo" 2>"$out/err")
+[ $? -eq 64 ] || fail "no model anywhere must exit 64"
+grep -q -- "give --model CKPT, set NEUFLOW_MODEL, or run \`neuflow fetch-model mixed\`" "$out/err" \
+  || fail "unclear missing-model error: $(cat "$out/err")"
+(cd "$out/cwd" && NEUFLOW_MODEL="$checkpoint" "$neuflow" flow --iters-s8 1 "${frames[@]}" "$out/env.flo" \
+  2>"$out/err") || fail "NEUFLOW_MODEL was not taken: $(cat "$out/err")"
+grep -q "(from NEUFLOW_MODEL)" "$out/err" || fail "NEUFLOW_MODEL taken silently: $(cat "$out/err")"
+ln -s "$checkpoint" "$out/cwd/models/neuflow_mixed.pth"
+(cd "$out/cwd" && env -u NEUFLOW_MODEL "$neuflow" flow --iters-s8 1 "${frames[@]}" "$out/default.flo" \
+  2>"$out/err") || fail "models/neuflow_mixed.pth was not taken: $(cat "$out/err")"
+grep -q "model models/neuflow_mixed.pth (no --model or NEUFLOW_MODEL given)" "$out/err" \
+  || fail "the default model taken silently: $(cat "$out/err")"
+cmp -s "$out/env.flo" "$out/default.flo" || fail "the same checkpoint by two routes gave two flows"
 echo "all flow command checks passed"

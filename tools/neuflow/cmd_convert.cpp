@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "common/model_path.hpp"
 #include "common/session_options.hpp"
 #include "convert/inputs.hpp"
 #include "convert/interruption.hpp"
@@ -133,12 +134,12 @@ CommandError interrupted(const InputSpec& input, const InputOutcome& outcome, st
 
 // What this run makes its flows with. The backend is the one the session opened (auto names
 // where it ran); the model, its content.
-OutputRecord record_of(const ConvertArgs& a, const model::FlowSession& session) {
+OutputRecord record_of(const std::string& model_path, const std::string& format, const model::FlowSession& session) {
   const model::SessionOptions& o = session.options();
   const std::string& where = session.backend_description();
   std::string model_sha1;
   try {
-    model_sha1 = git_blob_sha1_of_file(a.model);
+    model_sha1 = git_blob_sha1_of_file(model_path);
   } catch (const std::exception& e) {
     throw CommandError(kExitNoInput, e.what());
   }
@@ -150,7 +151,7 @@ OutputRecord record_of(const ConvertArgs& a, const model::FlowSession& session) 
           std::string(model::channel_order_name(o.network_order)),
           where.substr(0, where.find(' ')),
           std::string(model::precision_name(o.precision)),
-          a.format};
+          format};
 }
 
 void run_convert(const ConvertArgs& a) {
@@ -164,9 +165,10 @@ void run_convert(const ConvertArgs& a) {
   if (frames && a.max_frames > 0)
     throw CommandError(kExitUsage, "--frames and --max-frames both limit the frames: give one");
 
+  const std::string model_path = resolve_model(a.model, "convert");
   std::shared_ptr<const model::FlowModel> model;
   try {
-    model = model::FlowModel::load(a.model);
+    model = model::FlowModel::load(model_path);
   } catch (const model::CheckpointError& e) {
     throw CommandError(exit_code_for(e), e.what());
   }
@@ -182,7 +184,7 @@ void run_convert(const ConvertArgs& a) {
   settings.max_flow = a.max_flow;
   settings.resume = a.resume;
   settings.overwrite = a.overwrite;
-  settings.record = record_of(a, session);
+  settings.record = record_of(model_path, a.format, session);
   settings.max_frames = a.max_frames;
   settings.frames = frames;
   settings.image_rate = image_rate;
@@ -240,9 +242,7 @@ void register_convert(CLI::App& app) {
       "video file or URI, or two images) into OUTPUT/<input name>/: <frame>.flo|.npy|.png per pair, index.csv "
       "naming both frames of each flow, and optionally the colour rendering as viz/<frame>.png or viz.mp4. "
       "Video pairs are named frame_000123 (frame 123 -> 124), images by the first image's name");
-  sub->add_option("--model,-m", args->model, "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth")
-      ->envname("NEUFLOW_MODEL")
-      ->required();
+  sub->add_option("--model,-m", args->model, kModelOptionHelp);
   sub->add_option("--output,-o", args->output, "Output folder; each input gets a sub-folder named after it")
       ->required();
   sub->add_option("--pair", args->pairs, "Two images to compute one flow between (repeatable)");

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "common/model_path.hpp"
 #include "common/session_options.hpp"
 #include "neuflow/eval/errors.hpp"
 #include "neuflow/eval/evaluate.hpp"
@@ -153,6 +154,7 @@ void run(const EvalArgs& a) {
     };
   }
   std::vector<eval::SetResult> results;
+  results.reserve(sets.size());
   for (const auto& set : sets) results.push_back(eval::evaluate_set(set, source, options));
 
   const std::string table = eval::format_table(results, a.per_sequence);
@@ -200,11 +202,11 @@ void register_eval(CLI::App& app) {
       ->required()
       ->check(CLI::IsMember({"sintel", "kitti", "middlebury", "chairs"}));
   cmd->add_option("ROOT", a->root, "The dataset's folder")->required();
-  auto* source = cmd->add_option_group("source", "What to score (exactly one)");
-  auto* model = source->add_option("--model,-m", a->model, "NeuFlow-V2 checkpoint (.pth) to run on every pair");
-  source->add_option("--predictions", a->predictions,
-                     "Score precomputed flow files from this folder instead (naming below)");
-  source->require_option(1);
+  auto* source = cmd->add_option_group("source", "What to score (at most one; default: the model)");
+  source->add_option("--model,-m", a->model, std::string(kModelOptionHelp) + "; run on every pair");
+  auto* predictions = source->add_option("--predictions", a->predictions,
+                                         "Score precomputed flow files from this folder instead (naming below)");
+  source->require_option(0, 1);
   cmd->add_option("--pass", a->pass, "Sintel passes to evaluate")
       ->capture_default_str()
       ->check(CLI::IsMember({"clean", "final", "both"}));
@@ -225,9 +227,12 @@ void register_eval(CLI::App& app) {
   // The reference evaluation pads each pair itself, so no model size is offered here.
   add_session_options(*cmd, a->session, ModelSizeOptions::not_offered);
   for (const char* name : {"--iters-s16", "--iters-s8", "--threads", "--channel-order", "--bgr"}) {
-    cmd->get_option(name)->needs(model);
+    cmd->get_option(name)->excludes(predictions);
   }
-  cmd->callback([a] { run_mapping_errors(*a); });
+  cmd->callback([a] {
+    if (a->predictions.empty()) a->model = resolve_model(a->model, "eval");
+    run_mapping_errors(*a);
+  });
 }
 
 }  // namespace neuflow::cli

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "common/model_path.hpp"
 #include "common/session_options.hpp"
 #include "neuflow/flow/errors.hpp"
 #include "neuflow/flow/flow_io.hpp"
@@ -50,7 +51,7 @@ void run_flow(const FlowArgs& a) {
   if (img0.size() != img1.size()) {
     throw CommandError(kExitDataError, a.image0 + " and " + a.image1 + " differ in size");
   }
-  const auto model = load_model(a.model);
+  const auto model = load_model(resolve_model(a.model, "flow"));
   model::FlowSession session(model, options);
   std::string announced = announce_backend(session, "flow");
   const auto view = [](const cv::Mat& m) {  // OpenCV decodes to BGR
@@ -85,7 +86,7 @@ void run_flow(const FlowArgs& a) {
 void register_flow(CLI::App& app) {
   auto args = std::make_shared<FlowArgs>();
   auto* sub = app.add_subcommand("flow", "Compute the optical flow from IMG0 to IMG1 and write it to OUT");
-  sub->add_option("--model,-m", args->model, "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth")->required();
+  sub->add_option("--model,-m", args->model, kModelOptionHelp);
   add_session_options(*sub, args->session);
   sub->add_option("--viz", args->viz, "Also write the colour-wheel rendering of the flow to this PNG");
   sub->add_option("--max-flow", args->max_flow,

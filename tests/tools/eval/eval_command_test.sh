@@ -93,6 +93,8 @@ for r in d["results"]:
 PY
 
 run_expect 0 --dataset kitti "$K" --predictions "$P/kitti" --json -
+# NEUFLOW_MODEL names the model for runs that take one; predictions do not conflict with it.
+NEUFLOW_MODEL="$work/no-such-model.pth" run_expect 0 --dataset kitti "$K" --predictions "$P/kitti" --json -
 "$python" - "$work/stdout" <<'PY' || fail "kitti JSON on stdout"
 import json, sys
 d = json.load(open(sys.argv[1]))
