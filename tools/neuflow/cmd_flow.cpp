@@ -47,11 +47,12 @@ void run_flow(const FlowArgs& a) {
     throw CommandError(kExitUsage, a.output + ": the output's extension must be .flo, .npy or .png");
   }
   const model::SessionOptions options = session_options(a.session);
+  const std::string model_path = resolve_model(a.model, "flow");  // a usage error before any file is read
   const cv::Mat img0 = read_image(a.image0), img1 = read_image(a.image1);
   if (img0.size() != img1.size()) {
     throw CommandError(kExitDataError, a.image0 + " and " + a.image1 + " differ in size");
   }
-  const auto model = load_model(resolve_model(a.model, "flow"));
+  const auto model = load_model(model_path);
   model::FlowSession session(model, options);
   std::string announced = announce_backend(session, "flow");
   const auto view = [](const cv::Mat& m) {  // OpenCV decodes to BGR

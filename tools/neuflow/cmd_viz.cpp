@@ -1,4 +1,4 @@
-// `neuflow viz FLOW -o OUT.png [--max-flow N]`: renders a flow file with the standard
+// `neuflow viz FLOW [-o OUT.png] [--max-flow N]`: renders a flow file with the standard
 // Middlebury colour wheel.
 #include <algorithm>
 #include <cctype>
@@ -29,7 +29,9 @@ std::string require_png_name(const std::string& name) {
   return ext == ".png" ? std::string() : "the output is written as PNG; give it a .png name";
 }
 
-void run_viz(const VizOptions& options) {
+void run_viz(const VizOptions& given) {
+  VizOptions options = given;
+  if (options.output.empty()) options.output = options.input + ".png";
   flow::FlowField field;
   try {
     field = flow::read_flow(options.input);
@@ -59,7 +61,8 @@ void register_viz(CLI::App& app) {
   auto options = std::make_shared<VizOptions>();
   CLI::App* cmd = app.add_subcommand("viz", "Render a flow file (.flo, KITTI .png, .npy) as a colour-wheel PNG");
   cmd->add_option("FLOW", options->input, "Flow file: .flo, KITTI 16-bit .png or .npy (HxWx2)")->required();
-  cmd->add_option("-o,--output", options->output, "Output image (.png)")->required()->check(require_png_name);
+  cmd->add_option("-o,--output", options->output, "Output image (.png); default: FLOW's name plus .png, beside it")
+      ->check(require_png_name);
   CLI::Option* max_flow = cmd->add_option("--max-flow", options->max_flow,
                                           "Magnitude in px drawn fully saturated; larger vectors are dimmed. "
                                           "Default: the largest valid magnitude of the field")

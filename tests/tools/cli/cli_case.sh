@@ -46,6 +46,11 @@ case "$case_name" in
     run_expect 0 "$bin" viz "$gt/$1" -o "$work/fixed.png" --max-flow 20
     is_png "$work/fixed.png" || fail "fixed.png is not a PNG"
     expect_stdout "^max flow: 20\.000 px \(fixed"
+    # Without -o: beside the input, its name plus .png.
+    cp "$gt/$1" "$work/$(basename "$1")"
+    run_expect 0 "$bin" viz "$work/$(basename "$1")"
+    is_png "$work/$(basename "$1").png" || fail "viz without -o wrote no $(basename "$1").png"
+    expect_stdout "wrote .*$(basename "$1")\.png"
     ;;
   compare_self)  # compare_self FIXTURE: EPE 0, Fl 0
     need_fixture "$1"

@@ -50,7 +50,8 @@ std::optional<std::string> first_unknown_option(CLI::App& app, int argc, const c
 
 int report_parse_error(CLI::App& app, const CLI::ParseError& error, int argc, const char* const* argv) {
   if (error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(error);  // --help, --version
-  if (dynamic_cast<const CLI::RequiredError*>(&error) != nullptr) {
+  // An unknown option is the mistake to name, before what it left missing or extra.
+  if (dynamic_cast<const CLI::RequiredError*>(&error) != nullptr || dynamic_cast<const CLI::ExtrasError*>(&error)) {
     if (const auto unknown = first_unknown_option(app, argc, argv)) {
       app.exit(CLI::ExtrasError(std::vector<std::string>{*unknown}));
       return kExitUsage;
