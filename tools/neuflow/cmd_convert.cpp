@@ -271,7 +271,7 @@ void register_convert(CLI::App& app) {
           [](std::string& value) {
             return !value.empty() && value.find_first_not_of("0123456789") == std::string::npos
                        ? std::string()
-                       : "--max-frames wants 0 (all frames) or a number of frames, got '" + value + "'";
+                       : "wants 0 (all frames) or a number of frames, got '" + value + "'";  // after the name
           },
           "N"));
   sub->add_option("--fps", args->fps,

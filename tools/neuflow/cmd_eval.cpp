@@ -219,7 +219,7 @@ void register_eval(CLI::App& app) {
       ->check(CLI::Validator(
           [](std::string& value) {
             return value.size() > 4 && value.substr(value.size() - 4) == ".svg" ? std::string()
-                                                                                : "--plot writes SVG: FILE.svg";
+                                                                                : "writes SVG: give FILE.svg";
           },
           "FILE.svg"));
   cmd->add_option("--max-pairs", a->max_pairs, "Score only the first N pairs of each set (default: all)")

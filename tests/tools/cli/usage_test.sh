@@ -28,6 +28,10 @@ expect 64 "" no-such-subcommand
 expect 64 "nothing to convert" convert -m m.pth -o "$out/o"
 expect 64 "expected a multiple of 16" convert -m m.pth -o "$out/o" --model-width 100 --model-height 64 a.mp4
 expect 64 "Value -1 not in range|not in range" flow -m m.pth --iters-s8 -1 a.png b.png out.flo
+# Each option named once, with its dashes.
+expect 64 "^--max-frames: wants 0" convert -m m.pth -o "$out/o" a.mp4 --max-frames -1
+[ "$(grep -o -- "--max-frames" "$out/err" | wc -l)" -eq 1 ] || fail "--max-frames named twice"
+expect 64 "--model-width and --model-height go together" flow -m m.pth --model-width 32 a.png b.png out.flo
 # A bad NEUFLOW_CONV is a configuration error (EX_CONFIG), reported before any work.
 NEUFLOW_CONV=wingrad expect 78 "NEUFLOW_CONV: expected auto, direct, winograd, winograd4 or winograd6" flow -m m.pth a.png b.png out.flo
 "$neuflow" --help >/dev/null 2>&1 || fail "--help must exit 0"

@@ -1,7 +1,9 @@
 #include "common/session_options.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 #include "common/exit_codes.hpp"
 #include "neuflow/model/session_option_docs.hpp"
@@ -13,6 +15,23 @@ namespace docs = model::option_docs;
 // The option as the element's property and neuflowd's key name it, with the same help.
 std::string flag(const model::OptionDoc& doc) { return "--" + std::string(doc.name); }
 std::string help(const model::OptionDoc& doc) { return std::string(doc.help); }
+
+// The session's messages name settings ("model-width and model-height go together"); on the
+// command line each is an option: "--model-width and --model-height go together".
+std::string as_flags(std::string message) {
+  for (const model::OptionDoc* doc :
+       {&docs::iters_s16, &docs::iters_s8, &docs::model_width, &docs::model_height, &docs::threads, &docs::device}) {
+    const std::string name(doc->name);
+    for (std::size_t at = message.find(name); at != std::string::npos; at = message.find(name, at + name.size() + 2)) {
+      const bool word_start =
+          at == 0 || (message[at - 1] != '-' && !std::isalnum(static_cast<unsigned char>(message[at - 1])));
+      const std::size_t end = at + name.size();
+      const bool word_end = end == message.size() || !std::isalnum(static_cast<unsigned char>(message[end]));
+      if (word_start && word_end) message.insert(at, "--");
+    }
+  }
+  return message;
+}
 }  // namespace
 
 void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions model_size) {
@@ -80,7 +99,7 @@ model::SessionOptions session_options(const SessionArgs& args) {
                               : model::parse_channel_order(args.channel_order).value_or(model::ChannelOrder::rgb);
   options.backend = model::parse_backend(args.backend).value_or(model::Backend::automatic);
   options.precision = model::parse_precision(args.precision).value_or(model::Precision::fp32);
-  if (auto problem = model::check_session_options(options)) throw CommandError(kExitUsage, "--" + *problem);
+  if (auto problem = model::check_session_options(options)) throw CommandError(kExitUsage, as_flags(*problem));
   try {
     model::cpu_convolution_from_environment();
   } catch (const std::invalid_argument& e) {
