@@ -230,7 +230,8 @@ static void gst_neuflow_shm_sink_class_init(GstNeuflowShmSinkClass *klass) {
       g_param_spec_uint("shm-mode", "Shared-memory mode",
                         "Permissions of the segment, set exactly whatever the umask (write it in octal: shm-mode=0644; "
                         "gst-launch reads a leading 0 as octal). The default 0640 lets the owner's group read: run "
-                        "readers as that user or in that group. Read and write bits only, the owner's included",
+                        "readers as that user or in that group. Read and write bits only, the owner's included. "
+                        "gst-inspect-1.0 prints the values in decimal: 416 is 0640, 384 is 0600, 438 is 0666",
                         0600, 0666, DEFAULT_PROP_SHM_MODE, rw_ready));
 
   gst_element_class_set_static_metadata(

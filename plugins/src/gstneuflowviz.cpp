@@ -521,8 +521,9 @@ static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
   g_object_class_install_property(
       gobject_class, PROP_ARROW_COLOR,
       g_param_spec_uint("arrow-color", "Arrow colour",
-                        "Colour of the arrows as 0xAARRGGBB (AA = opacity; default opaque black)", 0, G_MAXUINT32,
-                        DEFAULT_PROP_ARROW_COLOR, rw));
+                        "Colour of the arrows as 0xAARRGGBB (AA = opacity; default opaque black, 0xFF000000, which "
+                        "gst-inspect-1.0 prints in decimal as 4278190080)",
+                        0, G_MAXUINT32, DEFAULT_PROP_ARROW_COLOR, rw));
   g_object_class_install_property(
       gobject_class, PROP_ARROW_SCALE,
       g_param_spec_double("arrow-scale", "Arrow scale",
