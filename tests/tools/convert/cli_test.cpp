@@ -605,6 +605,23 @@ TEST_F(ConvertCli, VideoOfImagesPlaysAtTheirTimestampRateOrAtFps) {
   }
   EXPECT_EQ(decoder.frame_rate().numerator, 25);
   EXPECT_EQ(convert(dir / "bad", {(dir / "camera").string(), "--fps", "0"}).exit_code, kExitUsage);
+
+  // The index gives each frame the time its name holds.
+  const auto index = read_csv(dir / "out" / "camera" / "index.csv");
+  ASSERT_EQ(index.size(), 3u);
+  for (std::size_t row = 1; row < index.size(); ++row) {
+    EXPECT_EQ(index[row][3], camera_frames_[row - 1].stem().string()) << "from_pts_ns of row " << row;
+    EXPECT_EQ(index[row][4], camera_frames_[row].stem().string()) << "to_pts_ns of row " << row;
+  }
+}
+
+TEST(ConvertFrameRate, NamesInSecondsToNanosecondsGiveCaptureTimesInNanoseconds) {
+  EXPECT_EQ(capture_times_ns({"1700000000", "1700000002"}),
+            (std::vector<std::int64_t>{1'700'000'000'000'000'000, 1'700'000'002'000'000'000}));
+  EXPECT_EQ(capture_times_ns({"1700000000040"}), (std::vector<std::int64_t>{1'700'000'000'040'000'000}));
+  EXPECT_TRUE(capture_times_ns({"9999999999999999999"}).empty()) << "past what ns in an int64 hold";
+  EXPECT_TRUE(capture_times_ns({"frame_1"}).empty());
+  EXPECT_TRUE(capture_times_ns({"1700000002", "1700000000"}).empty()) << "not increasing";
 }
 
 }  // namespace

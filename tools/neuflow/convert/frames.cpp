@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <utility>
 #include <vector>
@@ -29,7 +30,7 @@ struct ImageFile {
 
 class ImageSequence final : public FrameSource {
  public:
-  explicit ImageSequence(std::vector<ImageFile> files) : files_(std::move(files)) {}
+  explicit ImageSequence(std::vector<ImageFile> files) : files_(std::move(files)), times_(capture_times_ns(stems())) {}
 
   std::optional<Frame> next() override {
     if (next_ >= files_.size()) return std::nullopt;
@@ -46,19 +47,24 @@ class ImageSequence final : public FrameSource {
     frame.number = static_cast<std::int64_t>(next_);
     frame.source = file.path.filename().string();
     frame.output_stem = file.output_stem;
+    if (!times_.empty()) frame.pts_ns = times_[next_];
     ++next_;
     return frame;
   }
 
   std::optional<std::int64_t> frame_count() const override { return static_cast<std::int64_t>(files_.size()); }
-  pipeline::FrameRate frame_rate() const override {
-    std::vector<std::string> stems;
-    for (const auto& file : files_) stems.push_back(file.path.stem().string());
-    return rate_from_timestamps(stems);
-  }
+  pipeline::FrameRate frame_rate() const override { return rate_from_timestamps(stems()); }
 
  private:
+  std::vector<std::string> stems() const {
+    std::vector<std::string> stems;
+    stems.reserve(files_.size());
+    for (const auto& file : files_) stems.push_back(file.path.stem().string());
+    return stems;
+  }
+
   std::vector<ImageFile> files_;
+  std::vector<std::int64_t> times_;  // the names' capture times, or none
   std::size_t next_ = 0;
 };
 
@@ -128,32 +134,38 @@ std::vector<fs::path> list_images(const fs::path& folder) {
 
 }  // namespace
 
-pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems) {
-  if (stems.size() < 2) return {};
+std::vector<std::int64_t> capture_times_ns(const std::vector<std::string>& stems) {
+  if (stems.empty()) return {};
   const std::size_t digits = stems.front().size();
-  double unit = 0;  // seconds per tick
+  std::int64_t ns_per_tick = 0;
   switch (digits) {
-    case 10: unit = 1; break;
-    case 13: unit = 1e-3; break;
-    case 16: unit = 1e-6; break;
-    case 19: unit = 1e-9; break;
+    case 10: ns_per_tick = 1'000'000'000; break;
+    case 13: ns_per_tick = 1'000'000; break;
+    case 16: ns_per_tick = 1'000; break;
+    case 19: ns_per_tick = 1; break;
     default: return {};
   }
-  std::uint64_t previous = 0;
-  std::uint64_t first = 0;
-  for (std::size_t i = 0; i < stems.size(); ++i) {
-    const std::string& stem = stems[i];
+  std::vector<std::int64_t> times;
+  for (const std::string& stem : stems) {
     if (stem.size() != digits ||
         !std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) {
       return {};
     }
     const std::uint64_t t = std::stoull(stem);
-    if (i > 0 && t <= previous) return {};
-    if (i == 0) first = t;
-    previous = t;
+    // 19 digits fit an int64 only up to 9223372036854775807 ns (the year 2262).
+    if (t > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max() / ns_per_tick)) return {};
+    const std::int64_t ns = static_cast<std::int64_t>(t) * ns_per_tick;
+    if (!times.empty() && ns <= times.back()) return {};
+    times.push_back(ns);
   }
-  const double seconds = static_cast<double>(previous - first) * unit;
-  const double fps = static_cast<double>(stems.size() - 1) / seconds;
+  return times;
+}
+
+pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems) {
+  const std::vector<std::int64_t> times = capture_times_ns(stems);
+  if (times.size() < 2) return {};
+  const double seconds = static_cast<double>(times.back() - times.front()) * 1e-9;
+  const double fps = static_cast<double>(times.size() - 1) / seconds;
   if (!(fps > 0) || fps > 1000) return {};
   return {static_cast<int>(std::lround(fps * 1000)), 1000};
 }

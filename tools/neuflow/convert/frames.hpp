@@ -16,11 +16,13 @@
 namespace neuflow::cli {
 
 struct Frame {
-  cv::Mat pixels;                      // 8-bit, 3 channels
-  model::ChannelOrder data_order;      // how `pixels` holds them (OpenCV: BGR, GStreamer: RGB)
-  std::int64_t number = 0;             // 0-based position in the input
-  std::optional<std::int64_t> pts_ns;  // video frames' presentation time
-  std::string source;                  // the image's file name; empty for video frames
+  cv::Mat pixels;                  // 8-bit, 3 channels
+  model::ChannelOrder data_order;  // how `pixels` holds them (OpenCV: BGR, GStreamer: RGB)
+  std::int64_t number = 0;         // 0-based position in the input
+  // A video frame's presentation time; an image's capture time when the sequence's names are
+  // timestamps (capture_times_ns), in ns since the epoch.
+  std::optional<std::int64_t> pts_ns;
+  std::string source;  // the image's file name; empty for video frames
   // Base name of the outputs of the pair that starts at this frame: the image's stem (its
   // whole file name where two images of the folder share a stem), or frame_000123 for video.
   std::string output_stem;
@@ -42,6 +44,10 @@ class FrameSource {
 // increasing; the mean rate over the sequence, in thousandths of a frame per second. Unknown
 // for anything else and for fewer than two images.
 pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems);
+
+// Each name's time in ns, when the names are such timestamps (the rule above, a single one too);
+// empty otherwise.
+std::vector<std::int64_t> capture_times_ns(const std::vector<std::string>& stems);
 
 // Throws InputError when the input cannot be opened (missing, an empty folder…).
 std::unique_ptr<FrameSource> open_frames(const InputSpec& input);
