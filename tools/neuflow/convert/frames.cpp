@@ -108,6 +108,7 @@ std::vector<ImageFile> name_images(const std::vector<fs::path>& paths) {
   std::map<std::string, int> stems;
   for (const auto& p : paths) ++stems[p.stem().string()];
   std::vector<ImageFile> files;
+  files.reserve(paths.size());
   for (const auto& p : paths) {
     files.push_back({p, stems[p.stem().string()] > 1 ? p.filename().string() : p.stem().string()});
   }
