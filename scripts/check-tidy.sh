@@ -3,8 +3,9 @@
 # compile_commands.json (default build/release). A finding fails it.
 #   bash scripts/check-tidy.sh              # the .cpp files changed since $NEUFLOW_TIDY_BASE, and
 #                                           # the .cpp twins of changed headers; the default base is
-#                                           # the newest commit a day older than HEAD (a submission's
-#                                           # commits: CI runs on a clone of main, with no branch)
+#                                           # the newest commit three hours older than HEAD (a
+#                                           # submission's commits, made in one session of at most
+#                                           # three hours: CI runs on a clone of main, with no branch)
 #   bash scripts/check-tidy.sh --all        # every .cpp file (about 10 s a file on 2 cores)
 #   bash scripts/check-tidy.sh FILE...      # these files
 set -euo pipefail
@@ -24,7 +25,7 @@ if [ "${1:-}" = "--all" ]; then
 elif [ $# -gt 0 ]; then
   files=("$@")
 else
-  base=${NEUFLOW_TIDY_BASE:-$(git rev-list -1 --before=$(( $(git log -1 --format=%ct) - 86400 )) HEAD)}
+  base=${NEUFLOW_TIDY_BASE:-$(git rev-list -1 --before=$(( $(git log -1 --format=%ct) - 3 * 3600 )) HEAD)}
   if ! git rev-parse -q --verify "$base^{commit}" > /dev/null; then
     echo "check-tidy: base $base not found (a shallow clone?): checking nothing" >&2
     exit 0
