@@ -22,7 +22,10 @@ import sys
 import time
 import zlib
 
-import numpy as np
+try:
+    import numpy as np
+except ImportError:
+    sys.exit("read_flow_ring.py needs NumPy: apt install python3-numpy (or pip install numpy)")
 
 MAGIC = b"NFLOWRNG"
 LAYOUT_VERSION = 1

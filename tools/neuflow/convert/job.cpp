@@ -185,7 +185,9 @@ void Conversion::run(InputOutcome& outcome) {
     ++frames_read;
     if (to->pixels.size() != from->pixels.size()) {
       throw InputError(kExitDataError, describe(*to) + " is " + size_text(to->pixels) + " but " + describe(*from) +
-                                           " is " + size_text(from->pixels) + ": all frames of an input need one size");
+                                           " is " + size_text(from->pixels) +
+                                           ": all frames of an input need one size (a flow pairs two frames pixel "
+                                           "by pixel): resize them to one, or convert each size as its own input");
     }
     convert_pair(*from, *to, outcome);
     from = std::move(to);
