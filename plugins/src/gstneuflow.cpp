@@ -136,8 +136,11 @@ G_DEFINE_TYPE(GstNeuflow, gst_neuflow, GST_TYPE_ELEMENT)
 
 #define GST_NEUFLOW(obj) (reinterpret_cast<GstNeuflow *>(obj))
 
-#define NEUFLOW_VIDEO_CAPS \
-  GST_VIDEO_CAPS_MAKE("{ RGB, BGR, RGBx, BGRx, xRGB, xBGR, RGBA, BGRA, GRAY8, I420, NV12, YUY2 }")
+// The sizes the session takes (SessionLimits), so a frame it would refuse fails negotiation.
+#define NEUFLOW_VIDEO_CAPS                                                                                  \
+  "video/x-raw, format=(string){ RGB, BGR, RGBx, BGRx, xRGB, xBGR, RGBA, BGRA, GRAY8, I420, NV12, YUY2 }, " \
+  "width=(int)[ 32, 16384 ], height=(int)[ 32, 16384 ], framerate=(fraction)[ 0/1, 2147483647/1 ]"
+static_assert(SessionLimits::min_side == 32 && SessionLimits::max_side == 16384, "NEUFLOW_VIDEO_CAPS's sizes");
 
 static GstStaticPadTemplate sink_template =
     GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(NEUFLOW_VIDEO_CAPS));

@@ -410,6 +410,34 @@ TEST(NeuflowElementErrors, AMissingModelFailsTheStateChangeNamingTheFile) {
   gst_object_unref(pipeline);
 }
 
+// The pads say the sizes the session takes, so a 16×16 stream fails to link ("not negotiated")
+// instead of at its first buffer.
+TEST(NeuflowElementErrors, ThePadsAcceptOnlyTheFrameSizesTheSessionTakes) {
+  GstElementFactory* factory = gst_element_factory_find("neuflow");
+  ASSERT_NE(factory, nullptr) << "plugin not found: is GST_PLUGIN_PATH set?";
+  for (const GList* t = gst_element_factory_get_static_pad_templates(factory); t; t = t->next) {
+    auto* tmpl = static_cast<GstStaticPadTemplate*>(t->data);
+    GstCaps* caps = gst_static_caps_get(&tmpl->static_caps);
+    const GstStructure* s = gst_caps_get_structure(caps, 0);
+    for (const char* field : {"width", "height"}) {
+      const GValue* range = gst_structure_get_value(s, field);
+      ASSERT_TRUE(range && GST_VALUE_HOLDS_INT_RANGE(range)) << tmpl->name_template << " " << field;
+      EXPECT_EQ(gst_value_get_int_range_min(range), 32) << tmpl->name_template << " " << field;
+      EXPECT_EQ(gst_value_get_int_range_max(range), 16384) << tmpl->name_template << " " << field;
+    }
+    gst_caps_unref(caps);
+  }
+  gst_object_unref(factory);
+  GError* err = nullptr;
+  GstElement* pipeline = gst_parse_launch(
+      "videotestsrc num-buffers=2 ! video/x-raw,width=16,height=16 ! neuflow model=/nonexistent.pth ! fakesink", &err);
+  // The caps filter and the element cannot link at all: gst_parse_launch says so.
+  ASSERT_NE(err, nullptr) << "a 16x16 stream linked to the neuflow element";
+  EXPECT_NE(std::string(err->message).find("link"), std::string::npos) << err->message;
+  g_error_free(err);
+  if (pipeline) gst_object_unref(pipeline);
+}
+
 // backend=vulkan: a file pipeline writes the same flows as the CPU session that `neuflow
 // flow`/`convert` run, and its element says where it runs. The plugin holds its own copy of the
 // core, so the validation layer is fatal there (any message aborts the test).
