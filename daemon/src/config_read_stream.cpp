@@ -19,7 +19,7 @@ using SessionLimits = model::SessionLimits;
 FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContext& context) {
   namespace docs = model::option_docs;
   // The element's property names (option_docs), which the command's options share.
-  static constexpr std::array<std::string_view, 11> keys = {"model",
+  static constexpr std::array<std::string_view, 12> keys = {"model",
                                                             docs::iters_s16.name,
                                                             docs::iters_s8.name,
                                                             docs::model_width.name,
@@ -29,7 +29,8 @@ FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContex
                                                             docs::channel_order.name,
                                                             docs::backend.name,
                                                             docs::device.name,
-                                                            docs::precision.name};
+                                                            docs::precision.name,
+                                                            docs::max_memory.name};
   using model::Backend, model::Behaviour, model::ChannelOrder, model::Precision;
   static constexpr std::array<std::string_view, 2> precisions = {model::precision_name(Precision::fp32),
                                                                  model::precision_name(Precision::fp16)};
@@ -87,6 +88,9 @@ FlowConfig read_flow(const TableReader& t, const std::string& stream, ReadContex
   if (auto v = t.choice(docs::backend.name, backends))
     session.backend = model::parse_backend(*v).value_or(session.backend);
   if (auto v = t.integer(docs::device.name, -1, SessionLimits::max_device)) session.device = static_cast<int>(*v);
+  if (auto v = t.integer(docs::max_memory.name, 0, SessionLimits::max_memory_mb)) {
+    session.max_memory_mb = static_cast<int>(*v);
+  }
   if (auto v = t.choice(docs::precision.name, precisions)) {
     session.precision = model::parse_precision(*v).value_or(session.precision);
   }

@@ -12,6 +12,7 @@
 #include "backend_registry.hpp"
 #include "frame_geometry.hpp"
 #include "inference_backend.hpp"
+#include "memory_limit.hpp"
 
 namespace neuflow::model {
 
@@ -20,6 +21,7 @@ namespace neuflow::model {
 struct FlowSession::State {
   FrameGeometry geometry;
   std::unique_ptr<BackendRegistry> backends;  // where the network runs, and its fallback
+  const NetworkWeights* weights = nullptr;    // the model's, for the memory a plan needs
   std::unique_ptr<InferenceBackend> backend;  // the plan for the current model size
   Tensor input;                               // a frame converted here, for a backend that does not convert it itself
   int previous_slot = 0;
@@ -58,6 +60,7 @@ FlowSession::FlowSession(std::shared_ptr<const FlowModel> model, SessionOptions 
   if (auto problem = check_session_options(options_)) throw std::invalid_argument(*problem);
   cpu_convolution_from_environment();  // a bad NEUFLOW_CONV fails here, before any frame
   state_->backends = std::make_unique<BackendRegistry>(model_, options_);
+  state_->weights = &model_->weights();
 }
 
 FlowSession::~FlowSession() = default;
@@ -74,6 +77,16 @@ int FlowSession::max_in_flight() const {
   const auto& s = *state_;
   if (s.backend) return std::max(1, s.backend->stream_depth());
   return s.backends->stream_depth();
+}
+
+std::optional<std::string> FlowSession::memory_problem(int frame_width, int frame_height) const {
+  FrameGeometry g;
+  try {
+    g = plan_geometry(frame_width, frame_height, options_);
+  } catch (const std::invalid_argument&) {
+    return std::nullopt;  // a size the session refuses anyway, with its own reason
+  }
+  return model::memory_problem(*state_->weights, options_, g.model_height, g.model_width);
 }
 
 const std::string& FlowSession::backend_description() const { return state_->backends->description(); }
@@ -117,6 +130,9 @@ const FrameGeometry& prepare_plan(FlowSession::State& s, const SessionOptions& o
   if (s.backend && g == s.geometry) return s.geometry;
   finish_started(s);  // their passes use the plan about to be replaced
   if (!s.backend || s.backend->width() != g.model_width || s.backend->height() != g.model_height) {
+    if (auto problem = memory_problem(*s.weights, options, g.model_height, g.model_width)) {
+      throw std::invalid_argument(*problem);
+    }
     s.backend.reset();  // its buffers are released before the next plan's are made
     s.backend = s.backends->make(g.model_height, g.model_width);
   }

@@ -54,12 +54,19 @@ std::optional<std::string> check_model_size(int width, int height) {
   return std::nullopt;
 }
 
+std::optional<std::string> check_max_memory(int value) {
+  if (value >= 0 && value <= SessionLimits::max_memory_mb) return std::nullopt;
+  return "expected MiB from 0 (three quarters of the available memory) to " +
+         std::to_string(SessionLimits::max_memory_mb) + ", got " + std::to_string(value);
+}
+
 std::optional<std::string> check_session_options(const SessionOptions& options) {
   if (auto problem = check_iterations_s16(options.iterations.s16)) return "iters-s16: " + *problem;
   if (auto problem = check_iterations_s8(options.iterations.s8)) return "iters-s8: " + *problem;
   if (auto problem = check_model_size(options.model_width, options.model_height)) return problem;
   if (auto problem = check_threads(options.threads)) return "threads: " + *problem;
   if (auto problem = check_device(options.device)) return "device: " + *problem;
+  if (auto problem = check_max_memory(options.max_memory_mb)) return "max-memory: " + *problem;
   return std::nullopt;
 }
 

@@ -105,6 +105,7 @@ ElementChain plan_flow(const FlowStage& flow) {
               .set("backend", std::string(model::backend_name(s.backend)))
               .set("device", std::to_string(s.device))
               .set("precision", std::string(model::precision_name(s.precision)))
+              .set("max-memory", std::to_string(s.max_memory_mb))
               .set("stats-interval", "0")};  // the counters are read as properties
 }
 

@@ -301,6 +301,14 @@ void FlowEngine::post_drop(GstBuffer* dropped, const GstSegment& segment, guint6
 bool FlowEngine::set_format(GstCaps* caps) {
   GstVideoInfo info;
   if (!gst_video_info_from_caps(&info, caps) || !converter_.set_format(info)) return false;
+  // A frame size whose plan would not fit max-memory is refused here, at negotiation, with the
+  // need and the limit, instead of at the first frame or by the kernel's OOM killer.
+  if (session_) {
+    if (auto problem = session_->memory_problem(GST_VIDEO_INFO_WIDTH(&info), GST_VIDEO_INFO_HEIGHT(&info))) {
+      error(GST_CORE_ERROR, GST_CORE_ERROR_NEGOTIATION, *problem);
+      return false;
+    }
+  }
   if (have_info_ && (GST_VIDEO_INFO_WIDTH(&info) != GST_VIDEO_INFO_WIDTH(&info_) ||
                      GST_VIDEO_INFO_HEIGHT(&info) != GST_VIDEO_INFO_HEIGHT(&info_))) {
     GST_INFO_OBJECT(element_, "frame size changed: the stream of flows starts anew");

@@ -65,6 +65,7 @@ enum {
   PROP_BACKEND,
   PROP_DEVICE,
   PROP_PRECISION,
+  PROP_MAX_MEMORY,
   PROP_RUNNING_ON,
   PROP_BEHAVIOUR,
   PROP_STATS_INTERVAL,
@@ -73,7 +74,7 @@ enum {
   PROP_FLOWS,
   PROP_FRAMES_DROPPED,
   PROP_MEAN_LATENCY,
-  PROP_PROCESSING_RATE,
+  PROP_PROCESSING_RATE
 };
 
 // The session's settings, defaults and limits are the model's (neuflow/model/session_settings.hpp).
@@ -291,6 +292,7 @@ static void gst_neuflow_set_property(GObject *object, guint id, const GValue *va
     case PROP_BACKEND: s.session.backend = static_cast<Backend>(g_value_get_enum(value)); break;
     case PROP_DEVICE: s.session.device = g_value_get_int(value); break;
     case PROP_PRECISION: s.session.precision = static_cast<Precision>(g_value_get_enum(value)); break;
+    case PROP_MAX_MEMORY: s.session.max_memory_mb = as_int(); break;
     case PROP_BEHAVIOUR: s.behaviour = static_cast<Behaviour>(g_value_get_enum(value)); break;
     case PROP_STATS_INTERVAL: s.stats_interval = g_value_get_uint(value); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
@@ -330,6 +332,7 @@ static void gst_neuflow_get_property(GObject *object, guint id, GValue *value, G
     case PROP_BACKEND: g_value_set_enum(value, static_cast<gint>(s.session.backend)); break;
     case PROP_DEVICE: g_value_set_int(value, s.session.device); break;
     case PROP_PRECISION: g_value_set_enum(value, static_cast<gint>(s.session.precision)); break;
+    case PROP_MAX_MEMORY: g_value_set_uint(value, static_cast<guint>(s.session.max_memory_mb)); break;
     case PROP_BEHAVIOUR: g_value_set_enum(value, static_cast<gint>(s.behaviour)); break;
     case PROP_STATS_INTERVAL: g_value_set_uint(value, s.stats_interval); break;
     default: G_OBJECT_WARN_INVALID_PROPERTY_ID(object, id, pspec); break;
@@ -365,8 +368,7 @@ static void gst_neuflow_install_properties(GObjectClass *gobject_class) {
                                           "NeuFlow-V2 checkpoint (.pth), e.g. neuflow_mixed.pth; loaded once when "
                                           "the element leaves NULL and shared with other elements using the same file",
                                           nullptr, rw_null));
-  uint_setting(PROP_ITERS_S16, docs::iters_s16, "Iterations at 1/16", SessionLimits::max_iterations_s16,
-               d.iterations.s16);
+  uint_setting(PROP_ITERS_S16, docs::iters_s16, "Iters 1/16", SessionLimits::max_iterations_s16, d.iterations.s16);
   uint_setting(PROP_ITERS_S8, docs::iters_s8, "Iterations at 1/8", SessionLimits::max_iterations_s8, d.iterations.s8);
   uint_setting(PROP_MODEL_WIDTH, docs::model_width, "Model width", SessionLimits::max_side, d.model_width);
   uint_setting(PROP_MODEL_HEIGHT, docs::model_height, "Model height", SessionLimits::max_side, d.model_height);
@@ -378,10 +380,10 @@ static void gst_neuflow_install_properties(GObjectClass *gobject_class) {
                                         SessionLimits::max_device, d.device, rw));
   enum_setting(PROP_PRECISION, docs::precision, "Precision", gst_neuflow_precision_get_type(),
                static_cast<gint>(d.precision));
+  uint_setting(PROP_MAX_MEMORY, docs::max_memory, "Max memory", SessionLimits::max_memory_mb, d.max_memory_mb);
   install(PROP_RUNNING_ON,
           g_param_spec_string("running-on", "Running on",
-                              "Where the network runs, once the element is PAUSED: 'cpu' or 'vulkan device N (name)'",
-                              "", ro));
+                              "Where the network runs once PAUSED: cpu or vulkan device N (name)", "", ro));
   enum_setting(PROP_BEHAVIOUR, docs::behaviour, "Behaviour", gst_neuflow_behaviour_get_type(),
                static_cast<gint>(DEFAULT_PROP_BEHAVIOUR));
   install(PROP_STATS_INTERVAL,
@@ -392,8 +394,7 @@ static void gst_neuflow_install_properties(GObjectClass *gobject_class) {
   install(PROP_FRAMES_IN, g_param_spec_uint64("frames-in", "Frames in", "Frames received", 0, G_MAXUINT64, 0, ro));
   install(PROP_FRAMES_PROCESSED,
           g_param_spec_uint64("frames-processed", "Frames processed",
-                              "Frames computed, the first of a stream (which has no flow yet) included", 0, G_MAXUINT64,
-                              0, ro));
+                              "Frames computed, each stream's first (no flow yet) included", 0, G_MAXUINT64, 0, ro));
   install(PROP_FLOWS, g_param_spec_uint64("flows", "Flows",
                                           "Frames that left with a flow (frames-processed less the first frame of "
                                           "each stream, of each flush and of each size change)",

@@ -68,6 +68,13 @@ grep -q "model-width: expected a multiple of 16" "$out/err" || fail "unclear mod
 "$neuflow" flow -m "$fixture/checkpoint.pth" --size 160 "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo" \
   2>"$out/err"
 [ $? -eq 64 ] && grep -q "WIDTHxHEIGHT" "$out/err" || fail "--size without a height must say WIDTHxHEIGHT"
+# A frame size whose plan needs more than --max-memory is refused before the plan is made.
+"$neuflow" flow --max-memory 1 -m "$fixture/checkpoint.pth" "$fixture/frame0.png" "$fixture/frame1.png" "$out/x.flo" \
+  2>"$out/err"
+[ $? -ne 0 ] || fail "a plan over --max-memory ran"
+grep -q "a 320x256 model size needs about .*, more than the 1 MiB max-memory allows" "$out/err" \
+  || fail "unclear max-memory error: $(cat "$out/err")"
+
 # Without --model: $NEUFLOW_MODEL, else models/neuflow_mixed.pth in the working folder, each said
 # on stderr; with neither, a usage error naming all three.
 frames=("$(cd "$fixture" && pwd)/frame0.png" "$(cd "$fixture" && pwd)/frame1.png")

@@ -8,9 +8,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <thread>
+#include <utility>
 
 #include "frame_geometry.hpp"
+#include "memory_limit.hpp"
+#include "network.hpp"
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
@@ -167,6 +171,42 @@ TEST_F(SessionTest, ResizeModeAtTheInputSizeEqualsPaddingMode) {
   EXPECT_TRUE(all_finite(f));
 }
 
+// A model size whose plan would need more than max-memory is refused before the plan is made,
+// with the size, the need and the limit; smaller frames still run.
+TEST_F(SessionTest, APlanLargerThanMaxMemoryIsRefusedNamingTheNeed) {
+  FlowSession session(model_, {.threads = 2, .max_memory_mb = 8});
+  const auto problem = session.memory_problem(1280, 720);
+  ASSERT_TRUE(problem.has_value());
+  EXPECT_NE(problem->find("a 1280x720 model size needs about "), std::string::npos) << *problem;
+  EXPECT_NE(problem->find("more than the 8 MiB max-memory allows"), std::string::npos) << *problem;
+  cv::Mat big;
+  cv::resize(frames_[0], big, cv::Size(1280, 720));
+  try {
+    session.push(view_of(big));
+    FAIL() << "a plan over max-memory was made";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), *problem);
+  }
+  cv::Mat small;
+  cv::resize(frames_[0], small, cv::Size(64, 48));
+  EXPECT_FALSE(session.memory_problem(64, 48).has_value());
+  EXPECT_NO_THROW(session.push(view_of(small)));
+  EXPECT_THROW(FlowSession(model_, {.max_memory_mb = -1}), std::invalid_argument);
+}
+
+// The estimate a limit is checked against covers what the CPU plan then allocates.
+TEST_F(SessionTest, TheMemoryEstimateCoversTheCpuPlansAllocation) {
+  for (const auto& [w, h] : {std::pair{320, 256}, std::pair{768, 432}}) {
+    const NetworkPlan plan(model_->weights(), h, w, CpuConvolution::automatic);
+    const std::size_t estimate = estimate_plan_bytes(model_->weights(), h, w);
+    const std::size_t allocation = plan.memory().allocation;
+    EXPECT_GE(estimate, allocation) << w << "x" << h;
+    EXPECT_LE(estimate, 4 * allocation) << w << "x" << h << ": an estimate that refuses sizes that fit";
+    std::printf("%dx%d: estimate %.1f MB, the CPU plan's allocation %.1f MB\n", w, h,
+                static_cast<double>(estimate) / 1e6, static_cast<double>(allocation) / 1e6);
+  }
+}
+
 TEST_F(SessionTest, UnusableInputsAreRejectedWithAReason) {
   FlowSession session(model_, {.threads = 2});
   cv::Mat tiny(20, 40, CV_8UC3, cv::Scalar::all(0));
@@ -228,6 +268,7 @@ TEST_F(SessionTest, SessionsOnSeveralThreadsShareOneModel) {
   const auto expected12 = reference.compute(view_of(frames_[1]), view_of(frames_[2]));
   std::vector<double> errors(4, 1.0);
   std::vector<std::thread> threads;
+  threads.reserve(4);
   for (int t = 0; t < 4; ++t) {
     threads.emplace_back([&, t] {
       FlowSession session(model_, {.iterations = {1, 2}, .threads = 1});

@@ -410,6 +410,39 @@ TEST(NeuflowElementErrors, AMissingModelFailsTheStateChangeNamingTheFile) {
   gst_object_unref(pipeline);
 }
 
+// A frame size whose plan exceeds max-memory is refused at negotiation, naming the need and the
+// limit, before any frame (a 4096×4096 RGB frame alone is 48 MiB).
+TEST_F(NeuflowElement, AFrameSizeOverMaxMemoryFailsNegotiationNamingTheNeed) {
+  GError* err = nullptr;
+  GstElement* pipeline = gst_parse_launch(("videotestsrc num-buffers=2 ! video/x-raw,format=RGB,width=4096,height=4096 "
+                                           "! neuflow max-memory=64 threads=2 model=" +
+                                           model_ + " ! fakesink")
+                                              .c_str(),
+                                          &err);
+  ASSERT_EQ(err, nullptr) << err->message;
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  GstBus* bus = gst_element_get_bus(pipeline);
+  GstMessage* msg = gst_bus_timed_pop_filtered(bus, 30 * GST_SECOND,
+                                               static_cast<GstMessageType>(GST_MESSAGE_ERROR | GST_MESSAGE_EOS));
+  ASSERT_NE(msg, nullptr);
+  ASSERT_EQ(GST_MESSAGE_TYPE(msg), GST_MESSAGE_ERROR) << "a 4096x4096 stream ran with max-memory=64";
+  GError* error = nullptr;
+  gst_message_parse_error(msg, &error, nullptr);
+  const std::string text = error->message;
+  EXPECT_TRUE(g_error_matches(error, GST_CORE_ERROR, GST_CORE_ERROR_NEGOTIATION)) << text;
+  EXPECT_NE(text.find("a 4096x4096 model size needs about "), std::string::npos) << text;
+  EXPECT_NE(text.find("64 MiB max-memory"), std::string::npos) << text;
+  g_error_free(error);
+  gst_message_unref(msg);
+  gst_object_unref(bus);
+  GstElement* flow = gst_bin_get_by_name(GST_BIN(pipeline), "neuflow0");
+  ASSERT_NE(flow, nullptr);
+  EXPECT_EQ(uint64_property(flow, "frames-processed"), 0u);
+  gst_object_unref(flow);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
 // The pads say the sizes the session takes, so a 16×16 stream fails to link ("not negotiated")
 // instead of at its first buffer.
 TEST(NeuflowElementErrors, ThePadsAcceptOnlyTheFrameSizesTheSessionTakes) {

@@ -19,8 +19,8 @@ std::string help(const model::OptionDoc& doc) { return std::string(doc.help); }
 // The session's messages name settings ("model-width and model-height go together"); on the
 // command line each is an option: "--model-width and --model-height go together".
 std::string as_flags(std::string message) {
-  for (const model::OptionDoc* doc :
-       {&docs::iters_s16, &docs::iters_s8, &docs::model_width, &docs::model_height, &docs::threads, &docs::device}) {
+  for (const model::OptionDoc* doc : {&docs::iters_s16, &docs::iters_s8, &docs::model_width, &docs::model_height,
+                                      &docs::threads, &docs::device, &docs::max_memory}) {
     const std::string name(doc->name);
     for (std::size_t at = message.find(name); at != std::string::npos; at = message.find(name, at + name.size() + 2)) {
       const bool word_start =
@@ -69,6 +69,9 @@ void add_session_options(CLI::App& command, SessionArgs& args, ModelSizeOptions 
   command.add_option(flag(docs::precision), args.precision, help(docs::precision))
       ->check(CLI::IsMember({"fp32", "fp16"}))
       ->capture_default_str();
+  command.add_option(flag(docs::max_memory), o.max_memory_mb, help(docs::max_memory))
+      ->capture_default_str()
+      ->check(CLI::Range(0, L::max_memory_mb));
 }
 
 void report_late_fallback(const model::FlowSession& session, const char* subcommand, std::string& announced) {

@@ -60,6 +60,11 @@ class FlowSession {
 
   const SessionOptions& options() const { return options_; }
 
+  // Why frames of this size would need more memory than max-memory allows (the size, the need
+  // and the limit), or nothing; push() and compute() refuse such frames with this message. A
+  // GStreamer element asks at negotiation, before any frame.
+  std::optional<std::string> memory_problem(int frame_width, int frame_height) const;
+
   // Where the network runs: "cpu" or "vulkan device 0 (NVIDIA H200)".
   const std::string& backend_description() const;
   // What the session does other than asked, once: backend=auto leaving a GPU it found for the

@@ -34,6 +34,10 @@ inline constexpr OptionDoc precision{
     "precision",
     "What a Vulkan device stores tensors in: fp32 (exact), or fp16 (half the memory; devices with shaderFloat16, "
     "else fp32 with a warning); the CPU computes in fp32 either way"};
+inline constexpr OptionDoc max_memory{
+    "max-memory",
+    "MiB a model size's plan may take (its tensors, the frames it keeps, the flow it returns); a larger one is refused "
+    "with the need named. 0: three quarters of the memory available then"};
 inline constexpr OptionDoc behaviour{
     "behaviour",
     "How a stream keeps up: live holds real time by dropping frames, every-pair computes every consecutive pair, "

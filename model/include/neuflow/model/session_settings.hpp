@@ -53,7 +53,8 @@ struct SessionLimits {
   static constexpr int min_side = 32;
   static constexpr int max_side = 16384;  // frames and model sizes alike
   static constexpr int max_threads = 1024;
-  static constexpr int max_device = 63;  // a Vulkan device index; -1: the first GPU
+  static constexpr int max_device = 63;          // a Vulkan device index; -1: the first GPU
+  static constexpr int max_memory_mb = 1 << 20;  // 1 TiB
 };
 
 struct SessionOptions {
@@ -73,6 +74,9 @@ struct SessionOptions {
   int device = -1;
   Precision precision = Precision::fp32;
   CpuConvolution cpu_convolution = CpuConvolution::automatic;
+  // The most a plan for one model size may take, in MiB (its tensors, the frames it keeps, the
+  // flow it returns); 0: three quarters of the memory available when the plan is made.
+  int max_memory_mb = 0;
   bool operator==(const SessionOptions&) const = default;
 };
 
@@ -83,6 +87,7 @@ std::optional<std::string> check_iterations_s8(int value);
 std::optional<std::string> check_model_side(int value);  // one of model width/height; 0 allowed
 std::optional<std::string> check_threads(int value);
 std::optional<std::string> check_device(int value);
+std::optional<std::string> check_max_memory(int value);
 // Both sides: each usable, and both 0 or both set.
 std::optional<std::string> check_model_size(int width, int height);
 // The whole set, each problem prefixed with the setting's name ("iters-s8: expected …").
