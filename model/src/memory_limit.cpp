@@ -24,8 +24,8 @@ std::string megabytes(std::size_t bytes) { return std::to_string((bytes + kMiB -
 
 std::size_t estimate_plan_bytes(const NetworkWeights& weights, int model_height, int model_width) {
   const int tokens = std::max((model_height / 16) * (model_width / 16), 1);
-  const auto g = graph::build_network_graph<std::vector<float>>(
-      weights, model_height, model_width, Iterations{}, std::clamp(kScoreBlockFloats / tokens, 1, tokens));
+  const auto g = graph::build_network_graph<std::vector<float>>(weights, model_height, model_width, Iterations{},
+                                                                std::clamp(kScoreBlockFloats / tokens, 1, tokens));
   const graph::LiveRanges ranges = graph::live_ranges<std::vector<float>>(g.tensors, {&g.encode, &g.flow});
   std::vector<std::size_t> bytes(g.tensors.size(), 0);
   std::size_t fixed = 0;
@@ -65,7 +65,8 @@ std::optional<std::string> memory_problem(const NetworkWeights& weights, const S
   if (need <= *limit) return std::nullopt;
   return "a " + std::to_string(model_width) + "x" + std::to_string(model_height) + " model size needs about " +
          megabytes(need) + ", more than the " + megabytes(*limit) +
-         (options.max_memory_mb > 0 ? " max-memory allows" : " max-memory allows (three quarters of the available memory)") +
+         (options.max_memory_mb > 0 ? " max-memory allows"
+                                    : " max-memory allows (three quarters of the available memory)") +
          ": set model-width and model-height to run the network smaller, or raise max-memory";
 }
 

@@ -350,6 +350,23 @@ source = { type = "v4l2", pattern = "ball" }
   EXPECT_EQ(issues.size(), 5u) << test::listed(issues);
 }
 
+// max-memory: MiB, 0 (automatic) by default; a negative one is an error naming the key.
+TEST(Config, MaxMemoryIsReadInMebibytesAndChecked) {
+  const auto with = [](const std::string& value) {
+    return R"([[stream]]
+name = "s"
+source = { type = "test" }
+flow = { model = "/m.pth", max-memory = )" +
+           value + R"( }
+sink = [ { type = "display" } ]
+)";
+  };
+  EXPECT_EQ(parse(with("512")).streams.at(0).flow.stage.session.max_memory_mb, 512);
+  EXPECT_EQ(parse(kMinimalStream).streams.at(0).flow.stage.session.max_memory_mb, 0);
+  const auto issues = issues_of(with("-3"));
+  EXPECT_TRUE(has_issue(issues, 4, 0, "max-memory")) << test::listed(issues);
+}
+
 TEST(ConfigErrors, WrongTypesSayWhatWasExpectedAndWhatWasFound) {
   const auto issues = issues_of(R"([daemon]
 threads = "4"
