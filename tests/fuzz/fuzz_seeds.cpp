@@ -28,6 +28,9 @@
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/flow/kitti_png_format.hpp"
 #include "neuflow/flow/npy_format.hpp"
+#if NEUFLOW_FUZZ_SINK_SEEDS
+#include "flow_ring_writer.hpp"
+#endif
 #include "neuflow/flow_ring.hpp"
 #include "neuflow/model/checkpoint.hpp"
 
@@ -208,59 +211,33 @@ void copy_seeds(const fs::path& from, const fs::path& out, const std::string& ha
 
 void write_text(const fs::path& path, const std::string& text) { neuflow::test::write_file(path, text); }
 
-// A live ring of 3 slots with 4×2 flows, 4 published (slot 1 holds flow 4, the others 2 and 3),
-// as the shm sink writes it (docs/shm-ring.md).
-std::string ring_segment(std::uint32_t slots, std::uint64_t published) {
-  namespace r = neuflow::ring;
-  constexpr std::uint32_t width = 4, height = 2;
-  const std::uint64_t data_bytes = std::uint64_t{width} * height * 2 * sizeof(float);
-  const std::uint64_t stride = (sizeof(r::SlotHeader) + data_bytes + 7) / 8 * 8;
-  std::string segment(sizeof(r::RingHeader) + slots * stride, '\0');
-  r::RingHeader h{};
-  std::memcpy(h.magic, "NFLOWRNG", 8);
-  h.version = r::kLayoutVersion;
-  h.header_size = sizeof(r::RingHeader);
-  h.slot_count = slots;
-  h.slot_header_size = sizeof(r::SlotHeader);
-  h.slot_stride = stride;
-  h.grid_width = width;
-  h.grid_height = height;
-  h.value_layout = r::kValueLayoutF32UV;
-  h.state = static_cast<std::uint32_t>(r::SegmentState::live);
-  h.generation = 7;
-  h.flows_published = published;
-  h.segment_size = segment.size();
-  h.data_bytes = data_bytes;
-  std::memcpy(segment.data(), &h, sizeof h);
-  for (std::uint64_t n = published > slots ? published - slots + 1 : 1; n <= published; ++n) {
-    std::vector<float> uv(width * height * 2);
+#if NEUFLOW_FUZZ_SINK_SEEDS
+// The segment the shm sink's writer makes after publishing `flows` flows of 4×2 into `slots`
+// slots (docs/shm-ring.md), read from /dev/shm before the writer unlinks it.
+std::string written_ring(std::uint32_t slots, int flows) {
+  const std::string name = "/neuflow-fuzz-seed-" + std::to_string(::getpid());
+  neuflow::gst::FlowRingWriter writer(name, slots, 7);
+  std::vector<float> uv(4 * 2 * 2);
+  for (int n = 1; n <= flows; ++n) {
     for (std::size_t i = 0; i < uv.size(); ++i) uv[i] = static_cast<float>(n) + 0.25f * static_cast<float>(i);
-    r::SlotHeader slot{};
-    slot.sequence = 2 * n;
-    slot.from_frame = n - 1;
-    slot.to_frame = n;
-    slot.from_pts_ns = r::kNoTimestamp;
-    slot.to_pts_ns = r::kNoTimestamp;
-    slot.grid_width = width;
-    slot.grid_height = height;
-    slot.frame_width = 64;
-    slot.frame_height = 32;
-    slot.model_width = 64;
-    slot.model_height = 32;
-    slot.iters_s16 = 1;
-    slot.iters_s8 = 8;
-    slot.data_bytes = data_bytes;
-    slot.crc32 = r::crc32(uv.data(), data_bytes);
-    char* at = segment.data() + sizeof(r::RingHeader) + ((n - 1) % slots) * stride;
-    std::memcpy(at, &slot, sizeof slot);
-    std::memcpy(at + sizeof(r::SlotHeader), uv.data(), data_bytes);
+    neuflow::gst::FlowRecord record;
+    record.from_frame = static_cast<std::uint64_t>(n - 1);
+    record.to_frame = static_cast<std::uint64_t>(n);
+    record.frame_width = record.model_width = 64;
+    record.frame_height = record.model_height = 32;
+    record.iters_s16 = 1;
+    record.iters_s8 = 8;
+    writer.publish(4, 2, record, uv);
   }
-  return segment;
+  return neuflow::test::read_file("/dev/shm" + name);
 }
+#endif
 
 void write_sink_seeds(const fs::path& out) {
-  write_text(seed_path(out, "ring_reader", "live.ring"), ring_segment(3, 4));
-  write_text(seed_path(out, "ring_reader", "empty.ring"), ring_segment(2, 0));
+#if NEUFLOW_FUZZ_SINK_SEEDS
+  write_text(seed_path(out, "ring_reader", "wrapped.ring"), written_ring(3, 4));
+  write_text(seed_path(out, "ring_reader", "one.ring"), written_ring(2, 1));
+#endif
   write_text(seed_path(out, "flow_index", "index.csv"),
              "index,from_frame,to_frame,from_pts_ns,to_pts_ns,file,from_source,to_source\n"
              "0,0,1,0,33333333,flow_00000.flo,,\n"

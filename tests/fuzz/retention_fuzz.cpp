@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -27,20 +28,8 @@ bool usable(const std::string& name) {
 
 // The sink refuses patterns other than one integer conversion (and %%); so does this harness.
 bool one_integer_conversion(const std::string& pattern) {
-  int conversions = 0;
-  for (std::size_t i = 0; i < pattern.size(); ++i) {
-    if (pattern[i] != '%') continue;
-    if (i + 1 < pattern.size() && pattern[i + 1] == '%') {
-      ++i;
-      continue;
-    }
-    std::size_t j = i + 1;
-    while (j < pattern.size() && (pattern[j] == '0' || (pattern[j] >= '1' && pattern[j] <= '9'))) ++j;
-    if (j >= pattern.size() || pattern[j] != 'd' || j - i > 3) return false;
-    ++conversions;
-    i = j;
-  }
-  return conversions == 1;
+  static const std::regex one("([^%]|%%)*%0?[1-9]?d([^%]|%%)*");
+  return std::regex_match(pattern, one);
 }
 
 }  // namespace
