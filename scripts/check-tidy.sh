@@ -6,6 +6,8 @@
 #                                           # the newest commit three hours older than HEAD (a
 #                                           # submission's commits, made in one session of at most
 #                                           # three hours: CI runs on a clone of main, with no branch)
+#   NEUFLOW_TIDY_PART=sources|tests         # with the default: only the changed files outside tests/,
+#                                           # or only those in it (CI's first stage takes the sources)
 #   bash scripts/check-tidy.sh --all        # every .cpp file (about 10 s a file on 2 cores)
 #   bash scripts/check-tidy.sh FILE...      # these files
 set -euo pipefail
@@ -40,6 +42,11 @@ else
       continue
     fi
     [ "${f%.hpp}" != "$f" ] && f="${f%.hpp}.cpp"
+    case "${NEUFLOW_TIDY_PART:-all}:$f" in
+      sources:tests/*) continue ;;
+      tests:tests/*) ;;
+      tests:*) continue ;;
+    esac
     [ -f "$f" ] && files+=("$f")
   done
 fi

@@ -148,7 +148,7 @@ TEST(GraphPlan, FlowStageCarriesTheSessionSettings) {
   ASSERT_EQ(chain.size(), 2u);
   EXPECT_EQ(launch_text({chain[1]}),
             "neuflow name=flow model=\"/m.pth\" iters-s16=2 iters-s8=6 model-width=640 model-height=352 threads=3 "
-            "behaviour=live channel-order=bgr backend=vulkan device=1 precision=fp32 stats-interval=0");
+            "behaviour=live channel-order=bgr backend=vulkan device=1 precision=fp32 max-memory=0 stats-interval=0");
 }
 
 TEST(GraphPlan, RtspMediaIsTheChannelEncodedAndPacketized) {
