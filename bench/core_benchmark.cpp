@@ -11,9 +11,12 @@
 // GPU's timestamps. `--precision fp32,fp16` runs the GPU's benchmarks in both precisions, fp16
 // as `vulkan_fp16_*` with `x_fp32`: the fp32 time of the same benchmark in this run over its
 // own (a device without fp16 reports that as the benchmark's error instead of a figure).
+// The GPU's stream benchmarks also count what a streamed frame asks of the device (dispatches,
+// barriers, submissions, host waits, GMAC, MB read and written, from the commands' shapes);
+// --work prints every command of that frame.
 //
 //   neuflow-bench-core [--model CKPT] [--threads N] [--sizes 320x256,768x432]
-//                      [--backend cpu|vulkan] [--device N] [--precision fp32|fp16|fp32,fp16]
+//                      [--backend cpu|vulkan] [--device N] [--precision fp32|fp16|fp32,fp16] [--work]
 //                      [benchmark flags]
 //
 // Peak RSS is per process: run one size per process for per-size peaks (bench/run-core.sh).
@@ -42,6 +45,7 @@
 #include <system_error>
 #include <vector>
 
+#include "device_work_report.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/model/network_cost.hpp"
@@ -60,6 +64,7 @@ constexpr const char* kUsage =
     "  --backend cpu|vulkan  vulkan also runs the CPU, to compare\n"
     "  --device N            the Vulkan device (`neuflow devices`)\n"
     "  --precision fp32|fp16|fp32,fp16   the GPU's precisions\n"
+    "  --work                print every command a streamed frame gives the GPU\n"
     "Google Benchmark's flags:\n";
 
 using neuflow::model::FlowModel;
@@ -74,6 +79,7 @@ struct Config {
   int device = -1;
   std::vector<neuflow::model::Precision> precisions{neuflow::model::Precision::fp32};  // of the GPU's runs
   std::vector<std::pair<int, int>> sizes{{320, 256}, {512, 384}, {768, 432}, {1024, 448}};
+  bool work_tables = false;  // --work
 };
 
 Config g_config;
@@ -266,6 +272,8 @@ void BM_Stream(benchmark::State& state, int width, int height, Variant variant) 
   for (auto _ : state) total += timed_push(session, frames, i++);
   report(state, total / static_cast<double>(state.iterations()),
          neuflow::model::network_cost(height, width).stream_frame());
+  if (variant.backend == neuflow::model::Backend::vulkan)
+    neuflow::bench::add_work_counters(state, session.device_work());
   compare(state, "stream/" + std::to_string(width) + "x" + std::to_string(height), variant);
   if (variant.backend == neuflow::model::Backend::vulkan) {
     g_vulkan_push_ms[std::string(neuflow::model::precision_name(variant.precision)) + "/" + std::to_string(width) +
@@ -300,7 +308,15 @@ void BM_StreamPipelined(benchmark::State& state, int width, int height, Variant 
     benchmark::DoNotOptimize(f);
     ++i;
   }
+  const neuflow::model::DeviceWork work = session.device_work();  // of a frame with one in flight
   while (session.in_flight() > 0) session.take();
+  neuflow::bench::add_work_counters(state, work);
+  if (g_config.work_tables) {
+    neuflow::bench::print_work_table(stdout,
+                                     gpu_prefix(variant.precision) + "stream_pipelined/" + std::to_string(width) + "x" +
+                                         std::to_string(height) + ", " + session.backend_description(),
+                                     work);
+  }
   report(state, total / static_cast<double>(state.iterations()),
          neuflow::model::network_cost(height, width).stream_frame());
   const std::string key = std::to_string(width) + "x" + std::to_string(height);
@@ -450,6 +466,14 @@ int main(int argc, char** argv) {
   }
   std::string value;
   if (take_option(argc, argv, "--model", value)) g_config.model = value;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--work") == 0) {
+      g_config.work_tables = true;
+      for (int j = i; j + 1 < argc; ++j) argv[j] = argv[j + 1];
+      --argc;
+      break;
+    }
+  }
   if (take_option(argc, argv, "--frames", value)) g_config.frames = value;
   if (take_option(argc, argv, "--threads", value)) {
     const auto threads = int_option("--threads", value, neuflow::model::check_threads);

@@ -28,6 +28,7 @@ struct FlowSession::State {
   bool has_previous = false;
   StageObserver observer;
   std::vector<StageTime> stage_times;  // of the last compute(), push() or take()
+  DeviceWork work;                     // the same call's
   // Frames submitted and not taken, oldest first: on the backend still (started there), or
   // finished with their result kept.
   struct InFlight {
@@ -92,6 +93,7 @@ std::optional<std::string> FlowSession::memory_problem(int frame_width, int fram
 const std::string& FlowSession::backend_description() const { return state_->backends->description(); }
 const std::string& FlowSession::fallback_warning() const { return state_->backends->fallback(); }
 const std::vector<StageTime>& FlowSession::device_stage_times() const { return state_->stage_times; }
+const DeviceWork& FlowSession::device_work() const { return state_->work; }
 
 namespace {
 
@@ -152,7 +154,19 @@ void encode(FlowSession::State& s, const ImageView& frame, const FrameGeometry& 
 // A call with an observer reads every stage back, so its times are not the network's.
 void keep_stage_times(FlowSession::State& s) {
   s.stage_times = s.backend->take_stage_times();
-  if (s.observer) s.stage_times.clear();
+  s.work = s.backend->take_device_work();
+  if (s.observer) {
+    s.stage_times.clear();
+    s.work = {};
+  }
+}
+
+// Forgets what a call that failed half-way left.
+void drop_stage_times(FlowSession::State& s) {
+  s.stage_times.clear();
+  s.work = {};
+  s.backend->take_stage_times();
+  s.backend->take_device_work();
 }
 
 }  // namespace
@@ -170,8 +184,7 @@ flow::FlowField FlowSession::compute(const ImageView& frame0, const ImageView& f
   auto& s = *state_;
   finish_started(s);  // the backend computes pairs with nothing of the stream outstanding
   const FrameGeometry& g = prepare_plan(s, options_, frame0.width, frame0.height);
-  s.stage_times.clear();
-  s.backend->take_stage_times();  // what a call that failed half-way left
+  drop_stage_times(s);
   const auto [first, second] = free_slots(s.previous_slot);
   check_image(frame0, g);
   check_image(frame1, g);
@@ -196,8 +209,7 @@ std::optional<flow::FlowField> stream_now(FlowSession::State& s, const SessionOp
   validate(iterations);
   apply_threads(options.threads);
   const FrameGeometry& g = prepare_plan(s, options, frame.width, frame.height);
-  s.stage_times.clear();
-  s.backend->take_stage_times();
+  drop_stage_times(s);
   const int current = next_stream_slot(s);
   check_image(frame, g);
   encode(s, frame, g, options.network_order, current);
@@ -254,6 +266,7 @@ std::optional<flow::FlowField> FlowSession::take() {
   State::InFlight f = std::move(s.in_flight.front());
   s.in_flight.pop_front();
   s.stage_times.clear();  // a frame finished early (for compute() or a new size) has none
+  s.work = {};
   if (f.failure) std::rethrow_exception(f.failure);
   if (!f.started) return std::move(f.result);
   std::optional<flow::FlowField> result = finished_flow(s, f.geometry);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "frame_geometry.hpp"
+#include "neuflow/model/device_work.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
@@ -41,6 +42,8 @@ class InferenceBackend {
   // The device's own time for each stage of the passes since the last call, where the backend
   // measures one (the GPU's timestamps); the CPU's stages are timed with an observer instead.
   virtual std::vector<StageTime> take_stage_times() { return {}; }
+  // What the device was asked to do since the last call, where the backend counts it (a GPU's).
+  virtual DeviceWork take_device_work() { return {}; }
 
   // Pipelined streaming (FlowSession::submit): a backend that overlaps frames starts a step
   // (the frame's encoding into `slot` and, unless previous is -1, its pair) without waiting,

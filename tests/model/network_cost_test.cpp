@@ -10,9 +10,11 @@ namespace {
 
 double conv(int out_h, int out_w, int out_c, int in_c, int k) { return 2.0 * out_h * out_w * out_c * in_c * k * k; }
 
-double refine(int h, int w, int inter) {
-  return conv(h, w, 128, 212, 3) + conv(h, w, inter, 128, 3) + 5 * conv(h, w, inter, inter, 3) +
-         conv(h, w, 66, inter, 3);
+// `iterations` steps: conv1's share of the context and radius channels (65 of its 212 inputs)
+// once, the rest at every step.
+double refine(int h, int w, int inter, int iterations) {
+  return conv(h, w, 128, 65, 3) + iterations * (conv(h, w, 128, 147, 3) + conv(h, w, inter, 128, 3) +
+                                                5 * conv(h, w, inter, inter, 3) + conv(h, w, 66, inter, 3));
 }
 
 TEST(NetworkCost, EveryStageMatchesTheArithmeticByHand) {
@@ -30,10 +32,10 @@ TEST(NetworkCost, EveryStageMatchesTheArithmeticByHand) {
     const double layer = 2 * l * 192 * 192 * 4 + 2 * l * l * 192 * 2 + 2 * l * 384 * 384 + 2 * l * 384 * 192;
     EXPECT_DOUBLE_EQ(c.cross_attention, 4 * layer);  // two layers, both frames
     EXPECT_DOUBLE_EQ(c.global_matching, 2 * l * l * 128 + 2 * l * l * 2);
-    EXPECT_DOUBLE_EQ(c.refine_s16, it.s16 * refine(h16, w16, 128));
+    EXPECT_DOUBLE_EQ(c.refine_s16, refine(h16, w16, 128, it.s16));
     EXPECT_DOUBLE_EQ(c.merge_s8, 2 * (conv(h8, w8, 128, 256, 3) + conv(h8, w8, 128, 128, 3)) +
                                      conv(h8, w8, 64, 128, 3) + conv(h8, w8, 64, 64, 3));
-    EXPECT_DOUBLE_EQ(c.refine_s8, it.s8 * refine(h8, w8, 96));
+    EXPECT_DOUBLE_EQ(c.refine_s8, refine(h8, w8, 96, it.s8));
     EXPECT_DOUBLE_EQ(c.upsampler, conv(h8, w8, 256, 130, 3) + conv(h8, w8, 512, 256, 3) + conv(h8, w8, 576, 512, 1));
   }
 }

@@ -18,6 +18,7 @@
 #include "neuflow/model/checkpoint.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
+#include "support/camera_frames.hpp"
 #include "support/fixtures.hpp"
 
 namespace neuflow::model {
@@ -47,17 +48,7 @@ class SessionTest : public ::testing::Test {
     NEUFLOW_REQUIRE_FIXTURE(dir, "neuflow-v2-seed0/checkpoint.pth");
     NEUFLOW_REQUIRE_FIXTURE(frames, "frames");
     if (!model_) model_ = FlowModel::load(dir);
-    std::vector<std::filesystem::path> files;
-    for (const auto& e : std::filesystem::directory_iterator(frames)) {
-      if (e.path().extension() == ".jpg") files.push_back(e.path());
-    }
-    std::sort(files.begin(), files.end());
-    ASSERT_GE(files.size(), 3u);
-    for (int i = 0; i < 3; ++i) {
-      cv::Mat full = cv::imread(files[i].string(), cv::IMREAD_COLOR), small;
-      cv::resize(full, small, cv::Size(256, 144), 0, 0, cv::INTER_AREA);
-      frames_.push_back(small);
-    }
+    frames_ = test::camera_frames(frames, 3, cv::Size(256, 144));
   }
 
   static std::shared_ptr<const FlowModel> model_;

@@ -19,6 +19,7 @@
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/model/gpu_devices.hpp"
+#include "support/camera_frames.hpp"
 #include "support/fixtures.hpp"
 #include "support/vulkan.hpp"
 
@@ -85,17 +86,7 @@ class VulkanSession : public ::testing::Test {
     NEUFLOW_REQUIRE_FIXTURE(frames, "frames");
     NEUFLOW_REQUIRE_VULKAN();
     if (!model_) model_ = FlowModel::load(checkpoint);
-    std::vector<std::filesystem::path> files;
-    for (const auto& e : std::filesystem::directory_iterator(frames)) {
-      if (e.path().extension() == ".jpg") files.push_back(e.path());
-    }
-    std::sort(files.begin(), files.end());
-    ASSERT_GE(files.size(), 3u);
-    for (int i = 0; i < 3; ++i) {
-      cv::Mat full = cv::imread(files[i].string(), cv::IMREAD_COLOR), small;
-      cv::resize(full, small, cv::Size(200, 120), 0, 0, cv::INTER_AREA);  // → 208×128 padded
-      frames_.push_back(small);
-    }
+    frames_ = test::camera_frames(frames, 3, cv::Size(200, 120));  // → 208×128 padded
   }
   void TearDown() override { NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES(); }
 

@@ -11,6 +11,7 @@
 
 #include "graph/activation.hpp"
 #include "graph/tensors.hpp"
+#include "neuflow/model/device_work.hpp"
 #include "vulkan/vulkan_network.hpp"
 
 namespace neuflow::model::vulkan {
@@ -46,10 +47,19 @@ inline uint32_t tiles(long count, const char* what) {
   return static_cast<uint32_t>(std::max<long>(n, 1));
 }
 
-// Records one pass: every command is preceded by a barrier that orders it after everything
-// before it (the network is a chain; there is little to overlap inside one pass). With an
-// observer, observe() ends the command buffer, runs it, reads the tensor back and goes on in
-// a fresh recording.
+// What a command moves and computes: the bytes of the tensors it reads and writes, each once,
+// and its multiply-adds, from its shapes (DeviceWork).
+struct Work {
+  long long read = 0, written = 0, multiply_adds = 0;
+};
+
+// Records one pass. A command gets a barrier before it only where it depends on what came
+// before: it reads or writes a buffer written since the last barrier, or writes one read since
+// (the descriptors bind whole buffers, so whole buffers are what is tracked; which bindings a
+// shader reads and writes comes from its SPIR-V). A recording's first command always gets one,
+// which orders it after the queue's earlier submissions. With an observer, observe() ends the
+// command buffer, runs it, reads the tensor back and goes on in a fresh recording. What the
+// pass asks of the device is counted as it is recorded (work()).
 class VulkanNetwork::Recorder {
  public:
   // marks: where the stages' timestamps go (nullptr: not timed, as with an observer).
@@ -65,21 +75,25 @@ class VulkanNetwork::Recorder {
     begin();
     if (marks_) {
       vkCmdResetQueryPool(commands_, net_.timestamps_, query_base_, kTimestamps);
-      vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_, query_base_);
+      write_timestamp(query_base_);
     }
   }
 
   const Buffer& upload() const { return transfer_.upload; }
   const Buffer& readback() const { return transfer_.readback; }
+  const DeviceWork& work() const { return work_; }
+  // Bytes of `values` tensor values in the pass's precision.
+  long long bytes(long long values) const { return values * static_cast<long long>(net_.elem_); }
 
   // The end of the stage `name`: a timestamp once everything recorded before it has run.
   // Consecutive names without work between them (the backbone's outputs that the flow pass
   // only reads) take no timestamp.
   void mark(std::string_view name) {
+    for (std::size_t i = labelled_; i < work_.commands.size(); ++i) work_.commands[i].stage = name;
+    labelled_ = work_.commands.size();
     if (!marks_ || !worked_ || marks_->size() + 1 >= kTimestamps) return;
     marks_->emplace_back(name);
-    vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_,
-                        query_base_ + static_cast<uint32_t>(marks_->size()));
+    write_timestamp(query_base_ + static_cast<uint32_t>(marks_->size()));
     worked_ = false;
   }
 
@@ -87,6 +101,7 @@ class VulkanNetwork::Recorder {
     net_.device_.check(vkResetCommandBuffer(commands_, 0), "vkResetCommandBuffer");
     VkCommandBufferBeginInfo info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     net_.device_.check(vkBeginCommandBuffer(commands_, &info), "vkBeginCommandBuffer");
+    after_unknown_ = true;
   }
   void end() { net_.device_.check(vkEndCommandBuffer(commands_), "vkEndCommandBuffer"); }
   void run() {
@@ -101,33 +116,28 @@ class VulkanNetwork::Recorder {
     b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
     vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr, 0,
                          nullptr);
-  }
-
-  void barrier() {
-    worked_ = true;  // every command is recorded after its barrier
-    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                      VK_ACCESS_TRANSFER_WRITE_BIT;
-    const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
-    vkCmdPipelineBarrier(commands_, stages, stages, 0, 1, &b, 0, nullptr, 0, nullptr);
+    ++work_.barriers;
   }
 
   // S's push constants are its params header's struct (ShaderParams), so recording a shader with
   // another's parameters does not compile.
   template <Shader S>
-  void dispatch(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, uint32_t gx,
-                uint32_t gy = 1) {
-    record_dispatch(S, bindings, &push, sizeof push, gx, gy);
+  void dispatch(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, const Work& work,
+                uint32_t gx, uint32_t gy = 1) {
+    record_dispatch(S, bindings, &push, sizeof push, work, gx, gy);
   }
 
   void record_dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
-                       uint32_t gx, uint32_t gy) {
-    barrier();
+                       const Work& work, uint32_t gx, uint32_t gy) {
     std::array<VkBuffer, 4> handles{};
+    std::vector<VkBuffer> reads, writes;
+    const auto& access = shader_info(shader).bindings;
     for (std::size_t i = 0; i < handles.size(); ++i) {
       handles[i] = (bindings[i] ? *bindings[i] : net_.dummy_).handle();
+      if (access[i].reads) reads.push_back(handles[i]);
+      if (access[i].writes) writes.push_back(handles[i]);
     }
+    order(reads, writes);
     VkDescriptorSet set = net_.descriptor_set(handles);
     vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader, net_.fp16_));
     vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline_layout(), 0, 1, &set, 0,
@@ -135,31 +145,32 @@ class VulkanNetwork::Recorder {
     vkCmdPushConstants(commands_, net_.device_.pipeline_layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
                        static_cast<uint32_t>(bytes), push);
     vkCmdDispatch(commands_, gx, gy, 1);
+    ++work_.dispatches;
+    count(shader_name(shader), static_cast<std::uint64_t>(gx) * gy, work);
   }
 
   void copy(const View& src, const View& dst) {
-    barrier();
     const VkDeviceSize e = net_.elem_;
-    const VkBufferCopy region{static_cast<VkDeviceSize>(src.offset()) * e, static_cast<VkDeviceSize>(dst.offset()) * e,
-                              static_cast<VkDeviceSize>(src.count()) * e};
-    vkCmdCopyBuffer(commands_, src.buffer->handle(), dst.buffer->handle(), 1, &region);
+    copy_region(*src.buffer, *dst.buffer,
+                {static_cast<VkDeviceSize>(src.offset()) * e, static_cast<VkDeviceSize>(dst.offset()) * e,
+                 static_cast<VkDeviceSize>(src.count()) * e});
   }
   void copy_raw(const Buffer& src, const Buffer& dst, std::size_t values) {
-    barrier();
-    const VkBufferCopy region{0, 0, values * net_.elem_};
-    vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), 1, &region);
+    copy_region(src, dst, {0, 0, values * net_.elem_});
   }
   // A copy of the zero buffer: vkCmdFillBuffer needs 4-byte alignment, which 16-bit values
   // at an odd offset do not have.
   void zero(const View& dst) {
-    barrier();
-    const VkBufferCopy region{0, static_cast<VkDeviceSize>(dst.offset()) * net_.elem_,
-                              static_cast<VkDeviceSize>(dst.count()) * net_.elem_};
-    vkCmdCopyBuffer(commands_, net_.zeros_.handle(), dst.buffer->handle(), 1, &region);
+    copy_region(
+        net_.zeros_, *dst.buffer,
+        {0, static_cast<VkDeviceSize>(dst.offset()) * net_.elem_, static_cast<VkDeviceSize>(dst.count()) * net_.elem_});
   }
 
+  // c = a · b (m×k by k×n).
   void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulParams& p) {
-    dispatch<Shader::matmul>({&a, &b, &c, nullptr}, p, tiles(p.n, "attention"), tiles(p.m, "attention"));
+    const long long m = p.m, n = p.n, k = p.k;
+    dispatch<Shader::matmul>({&a, &b, &c, nullptr}, p, {bytes(m * k + k * n), bytes(m * n), m * n * k},
+                             tiles(p.n, "attention"), tiles(p.m, "attention"));
   }
 
   // The pass's frames: the slot that holds the frame each graph::FrameRole names (-1: none).
@@ -179,10 +190,9 @@ class VulkanNetwork::Recorder {
 
   // Copies `v` to the start of the ring entry's read-back buffer, for the host once the pass ends.
   void read_back(const View& v) {
-    barrier();
     const VkDeviceSize e = net_.elem_;
-    const VkBufferCopy region{static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e};
-    vkCmdCopyBuffer(commands_, v.buffer->handle(), transfer_.readback.handle(), 1, &region);
+    copy_region(*v.buffer, transfer_.readback,
+                {static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e});
     host_barrier();
   }
 
@@ -209,6 +219,57 @@ class VulkanNetwork::Recorder {
   bool observing() const { return observer_ != nullptr; }
 
  private:
+  void barrier() {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                      VK_ACCESS_TRANSFER_WRITE_BIT;
+    const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+    vkCmdPipelineBarrier(commands_, stages, stages, 0, 1, &b, 0, nullptr, 0, nullptr);
+    ++work_.barriers;
+  }
+
+  // A barrier before the next command where it depends on one since the last barrier.
+  void order(const std::vector<VkBuffer>& reads, const std::vector<VkBuffer>& writes) {
+    const auto in = [](const std::vector<VkBuffer>& set, VkBuffer b) {
+      return std::find(set.begin(), set.end(), b) != set.end();
+    };
+    bool depends = after_unknown_;
+    for (VkBuffer b : reads) depends = depends || in(written_, b);
+    for (VkBuffer b : writes) depends = depends || in(written_, b) || in(read_, b);
+    if (depends) {
+      barrier();
+      written_.clear();
+      read_.clear();
+      after_unknown_ = false;
+    }
+    read_.insert(read_.end(), reads.begin(), reads.end());
+    written_.insert(written_.end(), writes.begin(), writes.end());
+    worked_ = true;
+  }
+
+  void copy_region(const Buffer& src, const Buffer& dst, const VkBufferCopy& region) {
+    order({src.handle()}, {dst.handle()});
+    vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), 1, &region);
+    ++work_.copies;
+    const auto n = static_cast<long long>(region.size);
+    count("copy", 0, {n, n, 0});
+  }
+
+  void count(std::string kernel, std::uint64_t workgroups, const Work& w) {
+    work_.commands.push_back({std::move(kernel),
+                              {},
+                              workgroups,
+                              static_cast<std::uint64_t>(w.read),
+                              static_cast<std::uint64_t>(w.written),
+                              static_cast<std::uint64_t>(w.multiply_adds)});
+  }
+
+  void write_timestamp(uint32_t query) {
+    vkCmdWriteTimestamp(commands_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, net_.timestamps_, query);
+    ++work_.timestamps;
+  }
+
   VulkanNetwork& net_;
   VkCommandBuffer commands_;
   const StageObserver* observer_;
@@ -216,6 +277,12 @@ class VulkanNetwork::Recorder {
   const Transfer& transfer_;
   uint32_t query_base_;
   bool worked_ = false;  // commands recorded since the last timestamp
+  DeviceWork work_;
+  std::size_t labelled_ = 0;  // commands before this one have their stage
+  // Buffers written and read since the last barrier; after_unknown_: nothing is known of what
+  // ran before (a recording's start), so the next command waits for all of it.
+  std::vector<VkBuffer> written_, read_;
+  bool after_unknown_ = true;
   std::array<int, 3> frames_{-1, -1, -1};
   const FrameLayout* frame_layout_ = nullptr;
   std::vector<float> nhwc_;

@@ -3,15 +3,20 @@
 // shaders exist, their SPIR-V and their push-constant structs come from one list, the
 // neuflow_shader() calls in model/CMakeLists.txt (cmake/NeuflowShaders.cmake generates
 // shader_registry.hpp/.cpp from it).
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
+
+#include "vulkan/spirv_bindings.hpp"
 
 namespace neuflow::model::vulkan {
 
 // Every pipeline shares one push-constant range of this size (VulkanDevice's layout): the
 // smallest maxPushConstantsSize Vulkan guarantees.
 inline constexpr std::size_t kMaxPushConstantBytes = 128;
+// Every shader's storage buffers are bindings 0 to 3 of one set layout.
+inline constexpr std::size_t kShaderBindings = 4;
 
 struct ShaderInfo {
   const char* name;
@@ -19,6 +24,8 @@ struct ShaderInfo {
   std::span<const std::uint32_t> spirv_fp16;  // tensors stored as float16_t (precision.glsl)
   const char* params;                         // its push-constant struct (shaders/params/)
   std::size_t params_bytes;
+  // What it does with each binding, from its SPIR-V: the recorder's barriers follow it.
+  std::array<spirv_reflect::BindingAccess, kShaderBindings> bindings;
 };
 
 }  // namespace neuflow::model::vulkan

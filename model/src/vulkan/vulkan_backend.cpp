@@ -30,6 +30,7 @@ class VulkanBackend final : public InferenceBackend {
     return flow_;
   }
   std::vector<StageTime> take_stage_times() override { return network_.take_stage_times(); }
+  DeviceWork take_device_work() override { return network_.take_device_work(); }
 
   static_assert(kVulkanStreamDepth == vulkan::VulkanNetwork::kRing);
   int stream_depth() const override { return vulkan::VulkanNetwork::kRing; }

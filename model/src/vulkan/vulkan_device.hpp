@@ -84,7 +84,7 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   void check(VkResult result, std::string_view call) const;
 
   // Every binding of every shader is one of these storage buffers.
-  static constexpr int kBindings = 4;
+  static constexpr int kBindings = static_cast<int>(kShaderBindings);
   static constexpr std::size_t kPushConstantBytes = 128;
 
  private:

@@ -149,6 +149,7 @@ const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, int ent
     Recorder r(*this, pass.commands, nullptr, &pass.marks, entry);
     record(r);
     r.end();
+    pass.work = r.work();
   } catch (...) {
     vkFreeCommandBuffers(device_.handle(), pool_, 1, &pass.commands);
     throw;
@@ -158,6 +159,9 @@ const VulkanNetwork::Pass& VulkanNetwork::cached(const std::string& key, int ent
 
 void VulkanNetwork::run(const Pass& pass) {
   device_.submit_and_wait(pass.commands, ring_[static_cast<std::size_t>(pass.entry)].fence);
+  work_ += pass.work;
+  ++work_.submissions;
+  ++work_.host_waits;
   read_stage_times(pass);
 }
 
@@ -272,6 +276,8 @@ void VulkanNetwork::start(const Step& step) {
   });
   fill_upload(t, step.frame, step.image);  // the entry's last step is finished: nothing reads it
   device_.submit(pass.commands, t.fence);
+  work_ += pass.work;
+  ++work_.submissions;
   started_.push_back({entry, &pass, pair});
   next_entry_ = (entry + 1) % kRing;
 }
@@ -282,6 +288,7 @@ bool VulkanNetwork::finish(Tensor& out) {
   started_.pop_front();
   const Transfer& t = ring_[static_cast<std::size_t>(s.entry)];
   device_.wait(t.fence);
+  ++work_.host_waits;
   read_stage_times(*s.pass);
   if (s.pair) read_flow(t, out);
   return s.pair;

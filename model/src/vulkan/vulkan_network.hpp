@@ -26,6 +26,7 @@
 #include "graph/memory_plan.hpp"
 #include "graph/network_graph.hpp"
 #include "inference_backend.hpp"
+#include "neuflow/model/device_work.hpp"
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
 #include "tensor.hpp"
@@ -76,6 +77,9 @@ class VulkanNetwork {
   // The device time of each named stage of the passes run since the last call (none for a
   // pass with an observer, or on a queue without timestamps).
   std::vector<StageTime> take_stage_times() { return std::exchange(stage_times_, {}); }
+  // What the passes run since the last call asked of the device (none for a pass with an
+  // observer): their commands as recorded, and the submissions and host waits that ran them.
+  DeviceWork take_device_work() { return std::exchange(work_, {}); }
 
   // Ring entries: passes started and not yet finished.
   static constexpr int kRing = 2;
@@ -103,6 +107,7 @@ class VulkanNetwork {
     VkCommandBuffer commands = VK_NULL_HANDLE;
     std::vector<std::string> marks;
     int entry = 0;
+    DeviceWork work;  // its commands, counted when it was recorded
   };
   // What the host writes and reads while the device works: one per ring entry. The
   // synchronous calls use entry 0.
@@ -168,6 +173,7 @@ class VulkanNetwork {
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   std::vector<uint64_t> timestamp_values_;
   std::vector<StageTime> stage_times_;
+  DeviceWork work_;
   VkCommandBuffer observed_commands_ = VK_NULL_HANDLE;
 };
 

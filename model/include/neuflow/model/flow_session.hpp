@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "neuflow/flow/flow_field.hpp"
+#include "neuflow/model/device_work.hpp"
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/gpu_devices.hpp"
 #include "neuflow/model/image_view.hpp"
@@ -76,6 +77,10 @@ class FlowSession {
   // order it ran, the frames' encodings first. Empty on the CPU backend (time its stages with
   // an observer), while an observer is set, and on a device whose queue has no timestamps.
   const std::vector<StageTime>& device_stage_times() const;
+  // What the same call asked of the GPU: its commands, barriers, submissions and host waits,
+  // with each command's bytes and multiply-adds from its shapes (device_work.hpp). Empty where
+  // device_stage_times() is, except that a queue without timestamps still counts.
+  const DeviceWork& device_work() const;
 
   struct State;  // opaque per-session buffers and stream state
 

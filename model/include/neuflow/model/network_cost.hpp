@@ -2,7 +2,9 @@
 // The arithmetic NeuFlow-V2 costs at a given model size, stage by stage: multiply-adds × 2
 // of the convolutions and matrix products this implementation performs. The reference
 // additionally builds the all-pairs 1/8 correlation volume ((HW/64)² · 256 FLOP), which the
-// network doc's cost table includes and this core never computes.
+// network doc's cost table includes and this core never computes, and recomputes at every
+// refinement step the share of conv1 that reads the context (65 of its 212 inputs), which this
+// core computes once a pair. What the GPU's commands count (DeviceWork) adds up to this.
 #include "neuflow/model/session_settings.hpp"
 
 namespace neuflow::model {

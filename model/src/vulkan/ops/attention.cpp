@@ -14,8 +14,10 @@ void record_op(Recorder& r, const graph::Attention& op) {
     // scores[i][j] = q[:, r0 + i] · k[:, j]
     r.matmul(*q.buffer, *k.buffer, *scores.buffer,
              {n, l, dim, q.offset() + r0, 1, l, k.offset(), l, 1, scores.offset(), l, 1, -1, kActNone, 1.f});
+    const long long block = static_cast<long long>(n) * l;
     r.dispatch<Shader::softmax_rows>({nullptr, nullptr, scores.buffer, nullptr},
-                                     SoftmaxRowsParams{n, l, scores.offset()}, static_cast<uint32_t>(n));
+                                     SoftmaxRowsParams{n, l, scores.offset()}, {r.bytes(block), r.bytes(block), 0},
+                                     static_cast<uint32_t>(n));
     // message[:, r0 + i] = v · scores[i]ᵀ
     r.matmul(*v.buffer, *scores.buffer, *out.buffer,
              {v.c, n, l, v.offset(), l, 1, scores.offset(), 1, l, out.offset() + r0, l, 1, -1, kActNone, 1.f});

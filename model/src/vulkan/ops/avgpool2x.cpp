@@ -7,7 +7,7 @@ void record_op(Recorder& r, const graph::AvgPool2x& op) {
   require_whole(in, "average pooling");
   require_whole(out, "average pooling");
   r.dispatch<Shader::avgpool2x>({in.buffer, nullptr, out.buffer, nullptr}, Avgpool2xParams{in.c, in.h, in.w},
-                                groups(out.count(), kLocal));
+                                {r.bytes(in.count()), r.bytes(out.count()), 0}, groups(out.count(), kLocal));
 }
 
 }  // namespace neuflow::model::vulkan

@@ -24,7 +24,10 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
                        w.bias.offset,
                        op.addend ? addend.offset() : -1,
                        1.f};
+  const long long taps = static_cast<long long>(in.c) * w.kernel_h * w.kernel_w;
+  const long long read = in.count() + taps * out.c + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
   r.dispatch<Shader::conv2d>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
+                             {r.bytes(read), r.bytes(out.count()), taps * out.count()},
                              tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
 }
 

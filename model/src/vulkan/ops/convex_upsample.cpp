@@ -9,6 +9,7 @@ void record_op(Recorder& r, const graph::ConvexUpsample& op) {
   require_whole(out, "convex upsampling");
   r.dispatch<Shader::convex_upsample>({mask.buffer, flow.buffer, out.buffer, nullptr},
                                       ConvexUpsampleParams{flow.h, flow.w},
+                                      {r.bytes(mask.count() + flow.count()), r.bytes(out.count()), 9LL * out.count()},
                                       groups(static_cast<long>(out.h) * out.w, kLocal));
 }
 

@@ -16,14 +16,17 @@ void record_op(Recorder& r, const graph::GlobalMatching& op) {
     const int n = std::min(op.block_rows, l - r0);
     r.matmul(*f0.buffer, *f1.buffer, *scores.buffer,
              {n, l, f0.c, f0.offset() + r0, 1, l, f1.offset(), l, 1, scores.offset(), l, 1, -1, kActNone, alpha});
+    const long long block = static_cast<long long>(n) * l;
     r.dispatch<Shader::softmax_rows>({nullptr, nullptr, scores.buffer, nullptr},
-                                     SoftmaxRowsParams{n, l, scores.offset()}, static_cast<uint32_t>(n));
+                                     SoftmaxRowsParams{n, l, scores.offset()}, {r.bytes(block), r.bytes(block), 0},
+                                     static_cast<uint32_t>(n));
     r.matmul(
         *grid.buffer, *scores.buffer, *correspondence.buffer,
         {2, n, l, grid.offset(), l, 1, scores.offset(), 1, l, correspondence.offset() + r0, l, 1, -1, kActNone, 1.f});
   }
   const AxpbyParams p{out.count(), correspondence.offset(), grid.offset(), out.offset(), 1.f, -1.f};
-  r.dispatch<Shader::axpby>({correspondence.buffer, grid.buffer, out.buffer, nullptr}, p, groups(out.count(), kLocal));
+  r.dispatch<Shader::axpby>({correspondence.buffer, grid.buffer, out.buffer, nullptr}, p,
+                            {r.bytes(2LL * out.count()), r.bytes(out.count()), 0}, groups(out.count(), kLocal));
 }
 
 }  // namespace neuflow::model::vulkan

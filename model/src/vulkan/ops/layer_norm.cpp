@@ -13,7 +13,9 @@ void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op) {
                           op.residual ? residual.offset() : -1,
                           op.weights->gamma.offset,
                           op.weights->beta.offset};
-  r.dispatch<Shader::layer_norm>({&r.weights(), in.buffer, out.buffer, residual.buffer}, p, groups(tokens, kLocal));
+  const long long read = in.count() + 2LL * in.c + (op.residual ? out.count() : 0);
+  r.dispatch<Shader::layer_norm>({&r.weights(), in.buffer, out.buffer, residual.buffer}, p,
+                                 {r.bytes(read), r.bytes(out.count()), 0}, groups(tokens, kLocal));
 }
 
 }  // namespace neuflow::model::vulkan

@@ -22,7 +22,10 @@ void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op) {
                        w.bias.offset,
                        activation_code(op.act),
                        1.f};
-  r.dispatch<Shader::matmul>({&r.weights(), in.buffer, out.buffer, nullptr}, p, tiles(tokens, "attention"),
+  const long long weights = static_cast<long long>(w.out_features) * w.in_features;
+  const long long read = weights + (w.bias.offset >= 0 ? w.out_features : 0) + in.count();
+  r.dispatch<Shader::matmul>({&r.weights(), in.buffer, out.buffer, nullptr}, p,
+                             {r.bytes(read), r.bytes(out.count()), weights * tokens}, tiles(tokens, "attention"),
                              tiles(w.out_features, "attention"));
 }
 

@@ -14,8 +14,10 @@ void record_op(Recorder& r, const graph::RefineUpdate& op) {
     throw std::logic_error("the Vulkan refinement update needs the hidden state and the flow's copy in one tensor");
   }
   const RefineUpdateParams p{flow.h * flow.w, hidden.offset(), flow_copy.offset(), flow.offset()};
-  r.dispatch<Shader::refine_update>({update.buffer, nullptr, hidden.buffer, flow.buffer}, p,
-                                    groups(static_cast<long>(flow.h) * flow.w, kLocal));
+  r.dispatch<Shader::refine_update>(
+      {update.buffer, nullptr, hidden.buffer, flow.buffer}, p,
+      {r.bytes(update.count() + flow.count()), r.bytes(hidden.count() + flow_copy.count() + flow.count()), 0},
+      groups(static_cast<long>(flow.h) * flow.w, kLocal));
 }
 
 }  // namespace neuflow::model::vulkan

@@ -1,0 +1,139 @@
+// What a streamed frame asks of the GPU (FlowSession::device_work()): counted from the
+// commands' shapes when the passes are recorded, so it is the same on lavapipe as on a GPU and
+// can be held to budgets here. Not timed.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "neuflow/model/flow_model.hpp"
+#include "neuflow/model/flow_session.hpp"
+#include "neuflow/model/network_cost.hpp"
+#include "support/camera_frames.hpp"
+#include "support/fixtures.hpp"
+#include "support/vulkan.hpp"
+
+namespace neuflow::model {
+namespace {
+
+// A streamed frame's counts as of 2026-12-06, the same at any size whose attention fits one
+// score block (1024×448 and beyond): a change that raises them fails here, and a change that
+// lowers them lowers these. The GPU-throughput work aims at 100 dispatches and 100 barriers.
+constexpr int kDispatchBudget = 176;
+constexpr int kBarrierBudget = 174;
+// The bytes the commands read and write at 96×64 in fp32, the size tested here (75.0 MB, most of
+// it weights: the 1/8 refinement reads its own at every step).
+constexpr double kBytesBudget = 75.1e6;
+
+class VulkanWork : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    NEUFLOW_REQUIRE_FIXTURE(checkpoint, "neuflow-v2-seed0/checkpoint.pth");
+    NEUFLOW_REQUIRE_FIXTURE(frames, "frames");
+    NEUFLOW_REQUIRE_VULKAN();
+    if (!model_) model_ = FlowModel::load(checkpoint);
+    frames_ = test::camera_frames(frames, 3, cv::Size(kWidth, kHeight));
+  }
+  void TearDown() override { NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES(); }
+
+  ImageView frame(int i) const { return test::bgr_view(frames_.at(static_cast<std::size_t>(i))); }
+
+  static constexpr int kWidth = 96, kHeight = 64;
+  static std::shared_ptr<const FlowModel> model_;
+  std::vector<cv::Mat> frames_;
+};
+
+std::shared_ptr<const FlowModel> VulkanWork::model_;
+
+std::uint64_t multiply_adds_of(const DeviceWork& work, const std::set<std::string>& kernels) {
+  std::uint64_t n = 0;
+  for (const auto& c : work.commands) {
+    if (kernels.contains(c.kernel)) n += c.multiply_adds;
+  }
+  return n;
+}
+
+TEST_F(VulkanWork, AStreamedFrameIsCountedCommandByCommand) {
+  FlowSession gpu(model_, {.backend = Backend::vulkan, .device = 0});
+  gpu.push(frame(0));
+  ASSERT_TRUE(gpu.push(frame(1)).has_value());
+  const DeviceWork& work = gpu.device_work();
+  std::printf("a streamed %dx%d frame: %d dispatches, %d copies, %d barriers, %d submissions, %d host waits, "
+              "%.3f GMAC, %.2f MB read, %.2f MB written\n",
+              kWidth, kHeight, work.dispatches, work.copies, work.barriers, work.submissions, work.host_waits,
+              static_cast<double>(work.multiply_adds()) / 1e9, static_cast<double>(work.bytes_read()) / 1e6,
+              static_cast<double>(work.bytes_written()) / 1e6);
+
+  ASSERT_EQ(work.commands.size(), static_cast<std::size_t>(work.dispatches + work.copies));
+  // push() encodes the frame and runs the flow pass: two submissions, each waited for.
+  EXPECT_EQ(work.submissions, 2);
+  EXPECT_EQ(work.host_waits, 2);
+  for (const auto& c : work.commands) {
+    if (c.kernel == "copy") continue;
+    EXPECT_GE(c.workgroups, 1u) << c.kernel << " in " << c.stage;
+    EXPECT_GT(c.bytes_written, 0u) << c.kernel << " in " << c.stage;
+    EXPECT_FALSE(c.stage.empty()) << c.kernel << ": every dispatch belongs to a named stage";
+  }
+  // The convolutions' and products' multiply-adds are the network's arithmetic as
+  // network_cost() counts it from the architecture table (the attention's and matching's
+  // products included), which shares nothing with the recorder's count.
+  const double counted = static_cast<double>(multiply_adds_of(work, {"conv2d", "matmul"}));
+  const double expected = network_cost(kHeight, kWidth).stream_frame() / 2;
+  EXPECT_NEAR(counted, expected, expected * 1e-12);
+
+  // Barriers only between dependent commands: fewer than one per command.
+  EXPECT_LT(work.barriers, work.dispatches + work.copies);
+  EXPECT_LE(work.dispatches, kDispatchBudget);
+  EXPECT_LE(work.barriers, kBarrierBudget);
+  EXPECT_LE(static_cast<double>(work.bytes_read() + work.bytes_written()), kBytesBudget);
+}
+
+TEST_F(VulkanWork, APipelinedFrameTakesOneSubmissionAndOneWait) {
+  FlowSession gpu(model_, {.backend = Backend::vulkan, .device = 0});
+  gpu.submit(frame(0));
+  gpu.submit(frame(1));
+  gpu.take();  // the first frame: no pair
+  gpu.submit(frame(2));
+  ASSERT_TRUE(gpu.take().has_value());
+  const DeviceWork& work = gpu.device_work();
+  EXPECT_EQ(work.submissions, 1);
+  EXPECT_EQ(work.host_waits, 1);
+  FlowSession pushed(model_, {.backend = Backend::vulkan, .device = 0});
+  pushed.push(frame(1));
+  pushed.push(frame(2));
+  EXPECT_EQ(work.dispatches, pushed.device_work().dispatches) << "the same commands in one submission";
+}
+
+TEST_F(VulkanWork, Fp16MovesHalfTheBytes) {
+  if (!list_gpu_devices().at(0).fp16) GTEST_SKIP() << "Vulkan device 0 has no fp16";
+  FlowSession fp32(model_, {.backend = Backend::vulkan, .device = 0});
+  FlowSession fp16(model_, {.backend = Backend::vulkan, .device = 0, .precision = Precision::fp16});
+  for (auto* s : {&fp32, &fp16}) {
+    s->push(frame(0));
+    s->push(frame(1));
+  }
+  const DeviceWork &a = fp32.device_work(), &b = fp16.device_work();
+  EXPECT_EQ(a.dispatches, b.dispatches);
+  EXPECT_EQ(a.multiply_adds(), b.multiply_adds());
+  // Every tensor in 16 bits; only the 8-bit frame's upload is the same size.
+  const auto total = [](const DeviceWork& w) { return static_cast<double>(w.bytes_read() + w.bytes_written()); };
+  EXPECT_LT(total(b), 0.51 * total(a));
+  EXPECT_GT(total(b), 0.49 * total(a));
+}
+
+TEST_F(VulkanWork, AnObservedPassIsNotCounted) {
+  FlowSession gpu(model_, {.backend = Backend::vulkan, .device = 0});
+  gpu.set_observer([](const StageTensor&) {});
+  gpu.push(frame(0));
+  gpu.push(frame(1));
+  EXPECT_EQ(gpu.device_work().dispatches, 0);
+  FlowSession cpu(model_, {.backend = Backend::cpu});
+  cpu.push(frame(0));
+  cpu.push(frame(1));
+  EXPECT_TRUE(cpu.device_work().commands.empty());
+}
+
+}  // namespace
+}  // namespace neuflow::model
