@@ -100,9 +100,13 @@ struct NetworkWeights : BasicNetworkWeights<std::vector<float>> {};
 
 // ---- map_weights: every tensor of a network through `f` (const A& → B), shapes kept ----------
 
+// A function with a convolution(from, to) member also sees each convolution whole, once its
+// tensors are mapped (to add a form of the filters that only a convolution's shape defines).
 template <typename B, typename A, typename F>
 BasicConvWeights<B> map_weights(const BasicConvWeights<A>& w, F& f) {
-  return {w.out_channels, w.in_channels, w.kernel_h, w.kernel_w, f(w.weight), f(w.bias)};
+  BasicConvWeights<B> r{w.out_channels, w.in_channels, w.kernel_h, w.kernel_w, f(w.weight), f(w.bias)};
+  if constexpr (requires { f.convolution(w, r); }) f.convolution(w, r);
+  return r;
 }
 template <typename B, typename A, typename F>
 BasicLinearWeights<B> map_weights(const BasicLinearWeights<A>& w, F& f) {

@@ -135,6 +135,27 @@ TEST_F(VulkanSession, EveryStageEqualsTheCpuAtAnOddSizeAndOtherIterations) {
   EXPECT_LT(e.mean, 1e-3);
 }
 
+// The stride-1 3×3 convolutions by Winograd (the default, which every other test here runs)
+// and by the direct implicit GEMM (NEUFLOW_VULKAN_CONV=direct, the way back) give the CPU's
+// flow; a bad value is an error naming the variable.
+TEST_F(VulkanSession, DirectConvolutionsGiveTheCpusFlowToo) {
+  FlowSession cpu(model_, {.threads = 2, .backend = Backend::cpu});
+  const auto expected = cpu.compute(view_of(frames_[0]), view_of(frames_[1]));
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", "direct", 1), 0);
+  FlowSession direct(model_, {.backend = Backend::vulkan});
+  const Errors e = compare(direct.compute(view_of(frames_[0]), view_of(frames_[1])), expected);
+  EXPECT_LT(e.max, 1e-2);
+  EXPECT_LT(e.mean, 1e-3);
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", "fast", 1), 0);
+  try {
+    FlowSession bad(model_, {.backend = Backend::vulkan});
+    ADD_FAILURE() << "NEUFLOW_VULKAN_CONV=fast was accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("NEUFLOW_VULKAN_CONV"), std::string::npos) << error.what();
+  }
+  unsetenv("NEUFLOW_VULKAN_CONV");
+}
+
 TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {
   // Smaller than the other tests' frames (→ 112×64 padded): five passes on lavapipe, where the
   // size changes nothing this test checks but its time.
@@ -343,8 +364,8 @@ TEST_F(VulkanSession, ADeviceThatDoesNotExistIsAnErrorNamingIt) {
 
 // Each gtest case runs as its own process under ctest, so the budget applies to this one only.
 TEST_F(VulkanSession, RunningOutOfDeviceMemoryIsAnErrorAndAutoFallsBackToTheCpu) {
-  ASSERT_EQ(setenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB", "38", 1),
-            0);  // the weights (35 MiB) fit, a 208×128 plan does not
+  // The weights (35 MiB) and the Winograd filters (107 MiB) fit, a 208×128 plan does not.
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_MEMORY_BUDGET_MB", "145", 1), 0);
   {
     FlowSession session(model_, {.iterations = {1, 1}, .backend = Backend::vulkan, .device = 0});
     try {

@@ -21,11 +21,16 @@ namespace {
 // A streamed frame's counts as of 2026-12-06, the same at any size whose attention fits one
 // score block (1024×448 and beyond): a change that raises them fails here, and a change that
 // lowers them lowers these. The GPU-throughput work aims at 100 dispatches and 100 barriers.
-constexpr int kDispatchBudget = 176;
-constexpr int kBarrierBudget = 174;
-// The bytes the commands read and write at 96×64 in fp32, the size tested here (75.0 MB, most of
-// it weights: the 1/8 refinement reads its own at every step).
-constexpr double kBytesBudget = 75.1e6;
+struct Budget {
+  int dispatches, barriers;
+  double bytes;  // read and written at 96×64 in fp32, the size tested here
+};
+// Every convolution by the direct implicit GEMM (NEUFLOW_VULKAN_CONV=direct): 75.0 MB, most of
+// it weights (the 1/8 refinement reads its own at every step).
+constexpr Budget kDirect{176, 174, 75.1e6};
+// The stride-1 3×3 ones by Winograd: three dispatches each, transformed filters four times the
+// size of the filters (260.5 MB at this size, where weights dominate), tiles and products in fp32.
+constexpr Budget kWinograd{358, 352, 261e6};
 
 class VulkanWork : public ::testing::Test {
  protected:
@@ -55,16 +60,30 @@ std::uint64_t multiply_adds_of(const DeviceWork& work, const std::set<std::strin
   return n;
 }
 
+void print(const char* what, const DeviceWork& work) {
+  std::printf(
+      "a streamed frame, %s: %d dispatches, %d copies, %d barriers, %d submissions, %d host waits, "
+      "%.3f GMAC, %.2f MB read, %.2f MB written\n",
+      what, work.dispatches, work.copies, work.barriers, work.submissions, work.host_waits,
+      static_cast<double>(work.multiply_adds()) / 1e9, static_cast<double>(work.bytes_read()) / 1e6,
+      static_cast<double>(work.bytes_written()) / 1e6);
+}
+
+void expect_within(const DeviceWork& work, const Budget& budget) {
+  EXPECT_LT(work.barriers, work.dispatches + work.copies) << "barriers only between dependent commands";
+  EXPECT_LE(work.dispatches, budget.dispatches);
+  EXPECT_LE(work.barriers, budget.barriers);
+  EXPECT_LE(static_cast<double>(work.bytes_read() + work.bytes_written()), budget.bytes);
+}
+
 TEST_F(VulkanWork, AStreamedFrameIsCountedCommandByCommand) {
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", "direct", 1), 0);
   FlowSession gpu(model_, {.backend = Backend::vulkan, .device = 0});
+  unsetenv("NEUFLOW_VULKAN_CONV");
   gpu.push(frame(0));
   ASSERT_TRUE(gpu.push(frame(1)).has_value());
   const DeviceWork& work = gpu.device_work();
-  std::printf("a streamed %dx%d frame: %d dispatches, %d copies, %d barriers, %d submissions, %d host waits, "
-              "%.3f GMAC, %.2f MB read, %.2f MB written\n",
-              kWidth, kHeight, work.dispatches, work.copies, work.barriers, work.submissions, work.host_waits,
-              static_cast<double>(work.multiply_adds()) / 1e9, static_cast<double>(work.bytes_read()) / 1e6,
-              static_cast<double>(work.bytes_written()) / 1e6);
+  print("direct convolutions", work);
 
   ASSERT_EQ(work.commands.size(), static_cast<std::size_t>(work.dispatches + work.copies));
   // push() encodes the frame and runs the flow pass: two submissions, each waited for.
@@ -82,12 +101,27 @@ TEST_F(VulkanWork, AStreamedFrameIsCountedCommandByCommand) {
   const double counted = static_cast<double>(multiply_adds_of(work, {"conv2d", "matmul"}));
   const double expected = network_cost(kHeight, kWidth).stream_frame() / 2;
   EXPECT_NEAR(counted, expected, expected * 1e-12);
+  expect_within(work, kDirect);
+}
 
-  // Barriers only between dependent commands: fewer than one per command.
-  EXPECT_LT(work.barriers, work.dispatches + work.copies);
-  EXPECT_LE(work.dispatches, kDispatchBudget);
-  EXPECT_LE(work.barriers, kBarrierBudget);
-  EXPECT_LE(static_cast<double>(work.bytes_read() + work.bytes_written()), kBytesBudget);
+// Winograd F(4×4, 3×3) computes 36 products per 4×4 tile and channel pair where the direct
+// convolution computes 144: the frame's multiply-adds fall to at most 0.55 of the direct ones.
+TEST_F(VulkanWork, WinogradComputesAThirdOfTheMultiplyAdds) {
+  ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", "direct", 1), 0);
+  FlowSession direct(model_, {.backend = Backend::vulkan, .device = 0});
+  unsetenv("NEUFLOW_VULKAN_CONV");
+  FlowSession winograd(model_, {.backend = Backend::vulkan, .device = 0});
+  for (auto* s : {&direct, &winograd}) {
+    s->push(frame(0));
+    s->push(frame(1));
+  }
+  const DeviceWork &d = direct.device_work(), &w = winograd.device_work();
+  print("Winograd", w);
+  const double ratio = static_cast<double>(w.multiply_adds()) / static_cast<double>(d.multiply_adds());
+  std::printf("multiply-adds, Winograd over direct: %.3f\n", ratio);
+  EXPECT_LE(ratio, 0.55);
+  EXPECT_GT(multiply_adds_of(w, {"winograd_gemm"}), 0u);
+  expect_within(w, kWinograd);
 }
 
 TEST_F(VulkanWork, APipelinedFrameTakesOneSubmissionAndOneWait) {
@@ -106,7 +140,7 @@ TEST_F(VulkanWork, APipelinedFrameTakesOneSubmissionAndOneWait) {
   EXPECT_EQ(work.dispatches, pushed.device_work().dispatches) << "the same commands in one submission";
 }
 
-TEST_F(VulkanWork, Fp16MovesHalfTheBytes) {
+TEST_F(VulkanWork, Fp16HalvesTheTensorsBytes) {
   if (!list_gpu_devices().at(0).fp16) GTEST_SKIP() << "Vulkan device 0 has no fp16";
   FlowSession fp32(model_, {.backend = Backend::vulkan, .device = 0});
   FlowSession fp16(model_, {.backend = Backend::vulkan, .device = 0, .precision = Precision::fp16});
@@ -117,10 +151,19 @@ TEST_F(VulkanWork, Fp16MovesHalfTheBytes) {
   const DeviceWork &a = fp32.device_work(), &b = fp16.device_work();
   EXPECT_EQ(a.dispatches, b.dispatches);
   EXPECT_EQ(a.multiply_adds(), b.multiply_adds());
-  // Every tensor in 16 bits; only the 8-bit frame's upload is the same size.
-  const auto total = [](const DeviceWork& w) { return static_cast<double>(w.bytes_read() + w.bytes_written()); };
-  EXPECT_LT(total(b), 0.51 * total(a));
-  EXPECT_GT(total(b), 0.49 * total(a));
+  // Every tensor in 16 bits, command by command, except the 8-bit frame's upload and the
+  // Winograd tiles and products, which stay fp32.
+  ASSERT_EQ(a.commands.size(), b.commands.size());
+  int halved = 0;
+  for (std::size_t i = 0; i < a.commands.size(); ++i) {
+    const DeviceCommand &x = a.commands[i], &y = b.commands[i];
+    ASSERT_EQ(x.kernel, y.kernel);
+    if (x.kernel == "frame_u8" || x.kernel.starts_with("winograd_")) continue;
+    EXPECT_EQ(x.bytes_read, 2 * y.bytes_read) << x.kernel << " in " << x.stage;
+    EXPECT_EQ(x.bytes_written, 2 * y.bytes_written) << x.kernel << " in " << x.stage;
+    ++halved;
+  }
+  EXPECT_GT(halved, 90);
 }
 
 TEST_F(VulkanWork, AnObservedPassIsNotCounted) {

@@ -8,14 +8,31 @@
 
 #include "vulkan/half_float.hpp"
 #include "vulkan/one_shot_commands.hpp"
+#include "winograd/winograd_f43.hpp"
 
 namespace neuflow::model::vulkan {
 
 namespace {
 
-// Lays every tensor out in one host vector; offsets are in floats.
-class Packer {
- public:
+// G g Gᵀ for every (out, in) pair of a 3×3 convolution, as [36][out][in] (point 6·i + j of
+// the 6×6 result at i·6 + j), computed in double as the CPU backend's filters are.
+std::vector<float> winograd_f43_filters(const ConvWeights& conv) {
+  const int out = conv.out_channels, in = conv.in_channels;
+  std::vector<float> u(static_cast<std::size_t>(36) * out * in);
+  for (int o = 0; o < out; ++o) {
+    for (int i = 0; i < in; ++i) {
+      double g[9], columns[18], points[36];
+      for (int k = 0; k < 9; ++k) g[k] = conv.weight[(static_cast<std::size_t>(o) * in + i) * 9 + k];
+      for (int x = 0; x < 3; ++x) winograd::F43::filter_1d(g + x, columns + x, 3, 3);  // G g: [6][3]
+      for (int r = 0; r < 6; ++r) winograd::F43::filter_1d(columns + 3 * r, points + 6 * r, 1, 1);
+      for (int k = 0; k < 36; ++k) u[(static_cast<std::size_t>(k) * out + o) * in + i] = static_cast<float>(points[k]);
+    }
+  }
+  return u;
+}
+
+// Tensors laid out in one host vector; offsets are in floats.
+struct Packed {
   int add(const std::vector<float>& values) {
     const int offset = static_cast<int>(data.size());
     data.insert(data.end(), values.begin(), values.end());
@@ -23,49 +40,71 @@ class Packer {
     while (data.size() % 4 != 0) data.push_back(0.f);
     return offset;
   }
-  // map_weights()'s function: each host tensor appended, its offset kept; none stays none.
-  DeviceTensor operator()(const std::vector<float>& values) {
-    return values.empty() ? DeviceTensor{} : DeviceTensor{add(values)};
-  }
   std::vector<float> data;
 };
 
+// map_weights()'s function: each host tensor appended, its offset kept; none stays none. With
+// Winograd, each 3×3 convolution's filters are also appended transformed, to a vector of their
+// own: four times the size of the filters, they would take the weights' buffer past the 128 MiB
+// that many devices allow one storage buffer.
+struct Packer {
+  DeviceTensor operator()(const std::vector<float>& values) {
+    return values.empty() ? DeviceTensor{} : DeviceTensor{weights.add(values)};
+  }
+  void convolution(const ConvWeights& host, const DeviceConv& device) {
+    if (!winograd || host.kernel_h != 3 || host.kernel_w != 3) return;
+    winograd_filters.emplace(device.weight.offset, filters.add(winograd_f43_filters(host)));
+  }
+  bool winograd = false;
+  Packed weights, filters;
+  std::map<int, int> winograd_filters;
+};
+
+// `values` in a device buffer of their own, in the tensors' precision.
+Buffer upload_values(VulkanDevice& device, const std::vector<float>& values, bool fp16, const std::string& what) {
+  const std::size_t bytes = std::max<std::size_t>(values.size(), 1) * (fp16 ? 2 : 4);
+  Buffer buffer = device.create_buffer(bytes, VulkanDevice::Memory::device, what);
+  Buffer staging = device.create_buffer(bytes, VulkanDevice::Memory::upload, "uploading " + what);
+  if (fp16) {
+    auto* out = static_cast<std::uint16_t*>(static_cast<void*>(staging.mapped()));
+    for (std::size_t i = 0; i < values.size(); ++i) out[i] = to_half(values[i]);
+  } else {
+    std::memcpy(staging.mapped(), values.data(), values.size() * sizeof(float));
+  }
+  OneShotCommands commands(device);
+  const VkBufferCopy region{0, 0, bytes};
+  vkCmdCopyBuffer(commands.buffer(), staging.handle(), buffer.handle(), 1, &region);
+  commands.run();
+  return buffer;
+}
+
 std::shared_ptr<const DeviceWeights> upload(const std::shared_ptr<const FlowModel>& model,
-                                            const std::shared_ptr<VulkanDevice>& device, bool fp16) {
-  const NetworkWeights& w = model->weights();
+                                            const std::shared_ptr<VulkanDevice>& device, bool fp16, bool winograd) {
   auto d = std::make_shared<DeviceWeights>();
   d->model = model;
   d->device = device;
   d->fp16 = fp16;
   Packer p;
-  map_weights(w, p, *d);
-
-  const std::size_t bytes = p.data.size() * (fp16 ? 2 : 4);
-  d->buffer = device->create_buffer(bytes, VulkanDevice::Memory::device, "the model's weights");
-  Buffer staging = device->create_buffer(bytes, VulkanDevice::Memory::upload, "uploading the model's weights");
-  if (fp16) {
-    auto* out = static_cast<std::uint16_t*>(static_cast<void*>(staging.mapped()));
-    for (std::size_t i = 0; i < p.data.size(); ++i) out[i] = to_half(p.data[i]);
-  } else {
-    std::memcpy(staging.mapped(), p.data.data(), bytes);
-  }
-  OneShotCommands commands(*device);
-  const VkBufferCopy region{0, 0, bytes};
-  vkCmdCopyBuffer(commands.buffer(), staging.handle(), d->buffer.handle(), 1, &region);
-  commands.run();
+  p.winograd = winograd;
+  map_weights(model->weights(), p, *d);
+  d->buffer = upload_values(*device, p.weights.data, fp16, "the model's weights");
+  d->winograd_filters = std::move(p.winograd_filters);
+  d->winograd_buffer = upload_values(*device, p.filters.data, fp16, "the model's Winograd filters");
   return d;
 }
 
 }  // namespace
 
 std::shared_ptr<const DeviceWeights> DeviceWeights::get(const std::shared_ptr<const FlowModel>& model,
-                                                        const std::shared_ptr<VulkanDevice>& device, bool fp16) {
+                                                        const std::shared_ptr<VulkanDevice>& device, bool fp16,
+                                                        bool winograd) {
   static std::mutex mutex;
-  static std::map<std::tuple<const FlowModel*, const VulkanDevice*, bool>, std::weak_ptr<const DeviceWeights>> uploaded;
+  static std::map<std::tuple<const FlowModel*, const VulkanDevice*, bool, bool>, std::weak_ptr<const DeviceWeights>>
+      uploaded;
   const std::lock_guard lock(mutex);
-  auto& slot = uploaded[{model.get(), device.get(), fp16}];
+  auto& slot = uploaded[{model.get(), device.get(), fp16, winograd}];
   if (auto existing = slot.lock()) return existing;
-  auto weights = upload(model, device, fp16);
+  auto weights = upload(model, device, fp16, winograd);
   slot = weights;
   return weights;
 }

@@ -123,12 +123,12 @@ class VulkanNetwork::Recorder {
   // another's parameters does not compile.
   template <Shader S>
   void dispatch(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, const Work& work,
-                uint32_t gx, uint32_t gy = 1) {
-    record_dispatch(S, bindings, &push, sizeof push, work, gx, gy);
+                uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
+    record_dispatch(S, bindings, &push, sizeof push, work, {gx, gy, gz});
   }
 
   void record_dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
-                       const Work& work, uint32_t gx, uint32_t gy) {
+                       const Work& work, std::array<uint32_t, 3> grid) {
     std::array<VkBuffer, 4> handles{};
     std::vector<VkBuffer> reads, writes;
     const auto& access = shader_info(shader).bindings;
@@ -144,9 +144,9 @@ class VulkanNetwork::Recorder {
                             nullptr);
     vkCmdPushConstants(commands_, net_.device_.pipeline_layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0,
                        static_cast<uint32_t>(bytes), push);
-    vkCmdDispatch(commands_, gx, gy, 1);
+    vkCmdDispatch(commands_, grid[0], grid[1], grid[2]);
     ++work_.dispatches;
-    count(shader_name(shader), static_cast<std::uint64_t>(gx) * gy, work);
+    count(shader_name(shader), static_cast<std::uint64_t>(grid[0]) * grid[1] * grid[2], work);
   }
 
   void copy(const View& src, const View& dst) {
@@ -185,6 +185,11 @@ class VulkanNetwork::Recorder {
     return {&net_.buffer_of(s.tensor, frames_), s.channel, s.c, d.h, d.w};
   }
   const Buffer& weights() const { return net_.weights_->buffer; }
+  const DeviceWeights& device_weights() const { return *net_.weights_; }
+  // F(4×4, 3×3)'s transformed input tiles and their products (fp32), which the Winograd
+  // convolutions use in turn.
+  const Buffer& winograd_points() const { return net_.winograd_points_; }
+  const Buffer& winograd_products() const { return net_.winograd_products_; }
   int height() const { return net_.height_; }
   int width() const { return net_.width_; }
 

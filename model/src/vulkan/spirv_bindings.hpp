@@ -52,10 +52,10 @@ constexpr std::array<BindingAccess, N> binding_accesses(std::span<const std::uin
   for_each_instruction(words, [&](std::uint32_t op, std::size_t at, std::uint32_t count) {
     if (op != kOpDecorate || count < 4 || words[at + 1] != kDecorationBinding || words[at + 2] >= N) return true;
     const std::uint32_t variable = words[at], block = pointee_of_variable(words, variable);
-    const bool read_only = decorated(words, variable, kDecorationNonWritable) ||
-                           decorated(words, block, kDecorationNonWritable);
-    const bool write_only = decorated(words, variable, kDecorationNonReadable) ||
-                            decorated(words, block, kDecorationNonReadable);
+    const bool read_only =
+        decorated(words, variable, kDecorationNonWritable) || decorated(words, block, kDecorationNonWritable);
+    const bool write_only =
+        decorated(words, variable, kDecorationNonReadable) || decorated(words, block, kDecorationNonReadable);
     result[words[at + 2]] = {!write_only, !read_only};
     return true;
   });

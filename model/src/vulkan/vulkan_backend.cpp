@@ -1,5 +1,6 @@
 #include "vulkan/vulkan_backend.hpp"
 
+#include "vulkan/conv_algorithm.hpp"
 #include "vulkan/device_weights.hpp"
 #include "vulkan/vulkan_instance.hpp"
 #include "vulkan/vulkan_network.hpp"
@@ -78,7 +79,7 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
     for (std::size_t s = 0; s < vulkan::kShaderCount; ++s) device->pipeline(static_cast<vulkan::Shader>(s), true);
   }
   auto context = std::make_shared<VulkanContext>();
-  context->weights = vulkan::DeviceWeights::get(model, device, fp16);
+  context->weights = vulkan::DeviceWeights::get(model, device, fp16, vulkan::winograd_from_environment());
   return context;
 }
 

@@ -152,6 +152,7 @@ class VulkanNetwork {
   int height_, width_, tokens_, block_rows_;
 
   Buffer dummy_, zeros_;
+  Buffer winograd_points_, winograd_products_;  // sized for the largest Winograd convolution
   std::array<Transfer, kRing> ring_;
   int next_entry_ = 0;
   std::deque<Started> started_;

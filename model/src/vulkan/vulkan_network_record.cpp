@@ -9,6 +9,7 @@
 #include "vulkan/network_recorder.hpp"
 #include "vulkan/one_shot_commands.hpp"
 #include "vulkan/ops/record_op.hpp"
+#include "vulkan/ops/winograd.hpp"
 #include "vulkan/vulkan_network.hpp"
 
 namespace neuflow::model::vulkan {
@@ -80,6 +81,19 @@ void VulkanNetwork::allocate_tensors() {
     }
   }
   dummy_ = make(4, "a placeholder binding");
+  std::size_t points = 1, products = 1;  // fp32 values
+  for (const auto* ops : {&graph_.encode, &graph_.flow}) {
+    for (const auto& node : *ops) {
+      const auto* conv = std::get_if<graph::Conv2d<DeviceTensor>>(&node.op);
+      if (!conv || !takes_winograd(*weights_, *conv)) continue;
+      const graph::TensorDesc& out = graph_.tensors.at(conv->out.tensor);
+      const std::size_t tiles = static_cast<std::size_t>(winograd_tiles(out.w)) * winograd_tiles(out.h);
+      points = std::max(points, 36 * static_cast<std::size_t>(conv->in.c) * tiles);
+      products = std::max(products, 36 * static_cast<std::size_t>(conv->out.c) * tiles);
+    }
+  }
+  winograd_points_ = device_.create_buffer(points * sizeof(float), M::device, "the Winograd tiles" + size);
+  winograd_products_ = device_.create_buffer(products * sizeof(float), M::device, "the Winograd products" + size);
   zeros_ = make(zeroed, "zeros");
   for (std::size_t e = 0; e < ring_.size(); ++e) {
     ring_[e].upload = make(3 * hw, "the frame upload", M::upload);

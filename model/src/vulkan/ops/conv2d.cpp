@@ -1,13 +1,58 @@
 #include "vulkan/ops/record_op.hpp"
+#include "vulkan/ops/winograd.hpp"
 
 namespace neuflow::model::vulkan {
 
-// The implicit-GEMM convolution (matmul.comp with IMPLICIT_CONV): one 64×64 tile of
+namespace {
+
+// F(4×4, 3×3) in three dispatches: the input tiles transformed, 36 products of the filters
+// transformed at upload by those tiles, the products transformed back with bias, addend and
+// activation. A quarter of the direct convolution's multiply-adds, at the cost of moving the
+// tiles and products (fp32) through memory.
+void record_winograd(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
+                     const View& addend) {
+  const DeviceConv& w = *op.weights;
+  const int tiles_x = winograd_tiles(out.w), tile_count = tiles_x * winograd_tiles(out.h);
+  const long long points = 36LL * in.c * tile_count, products = 36LL * out.c * tile_count;
+  const auto fp32 = [](long long values) { return values * static_cast<long long>(sizeof(float)); };
+  r.dispatch<Shader::winograd_input>({in.buffer, nullptr, &r.winograd_points(), nullptr},
+                                     WinogradInputParams{in.c, in.h, in.w, in.offset(), tiles_x, tile_count},
+                                     {r.bytes(in.count()), fp32(points), 0},
+                                     groups(static_cast<long>(in.c) * tile_count, kLocal));
+  const long long filters = 36LL * out.c * in.c;
+  r.dispatch<Shader::winograd_gemm>(
+      {&r.device_weights().winograd_buffer, &r.winograd_points(), &r.winograd_products(), nullptr},
+      WinogradGemmParams{out.c, tile_count, in.c, r.device_weights().winograd_filters_of(w)},
+      {r.bytes(filters) + fp32(points), fp32(products), filters * tile_count}, tiles(tile_count, "a convolution"),
+      tiles(out.c, "a convolution"), 36);
+  const WinogradOutputParams p{out.c,
+                               out.h,
+                               out.w,
+                               out.offset(),
+                               tiles_x,
+                               tile_count,
+                               w.bias.offset,
+                               op.addend ? addend.offset() : -1,
+                               activation_code(op.act)};
+  const long long read = fp32(products) + r.bytes((w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0));
+  r.dispatch<Shader::winograd_output>({&r.weights(), &r.winograd_products(), out.buffer, addend.buffer}, p,
+                                      {read, r.bytes(out.count()), 0},
+                                      groups(static_cast<long>(out.c) * tile_count, kLocal));
+}
+
+}  // namespace
+
+// Stride-1 3×3 convolutions by Winograd where their filters were transformed at upload; the
+// rest by the implicit-GEMM convolution (matmul.comp with IMPLICIT_CONV): one 64×64 tile of
 // (pixels × output channels) per workgroup.
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
   const DeviceConv& w = *op.weights;
   const View in = r.view(op.in), out = r.view(op.out);
   const View addend = op.addend ? r.view(*op.addend) : View{};
+  if (takes_winograd(r.device_weights(), op)) {
+    record_winograd(r, op, in, out, addend);
+    return;
+  }
   const Conv2dParams p{in.c,
                        in.h,
                        in.w,

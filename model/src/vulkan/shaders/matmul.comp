@@ -7,17 +7,27 @@
 //    matrix and B the im2col of a planar [C][H][W] input, gathered on the fly (never stored);
 //    C is the planar output. Bias and activation fused; `addend` (same shape as C) is added
 //    before the activation.
+//  - WINOGRAD_GEMM: the 36 products of F(4×4, 3×3), one per workgroup z: the transformed
+//    filters [36][Cout][Cin] (binding 0) by the transformed input tiles [36][Cin][tiles] into
+//    [36][Cout][tiles]; the tiles and products are fp32 in either precision.
 //  - otherwise a general strided product (attention, matching): every operand has a row and a
 //    column stride, so transposes are free.
 layout(local_size_x = 16, local_size_y = 16) in;
 
 layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
+#ifdef WINOGRAD_GEMM
+layout(std430, binding = 1) readonly buffer BufB { float b_data[]; };
+layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };
+#else
 layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
 layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
+#endif
 layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend
 
 #ifdef IMPLICIT_CONV
 #include "params/conv2d_params.h"
+#elif defined(WINOGRAD_GEMM)
+#include "params/winograd_gemm_params.h"
 #else
 #include "params/matmul_params.h"
 #endif
@@ -26,21 +36,7 @@ const int BM = 64, BN = 64, BK = 16;
 shared float tile_a[BK][BM];
 shared float tile_b[BK][BN];
 
-float erf_approx(float x) {
-  // Abramowitz & Stegun 7.1.26 refined (|error| < 1.2e-7): GLSL has no erf.
-  float t = 1.0 / (1.0 + 0.5 * abs(x));
-  float y = 1.0 - t * exp(-x * x - 1.26551223 + t * (1.00002368 + t * (0.37409196 + t * (0.09678418 +
-            t * (-0.18628806 + t * (0.27886807 + t * (-1.13520398 + t * (1.48851587 +
-            t * (-0.82215223 + t * 0.17087277)))))))));
-  return x >= 0.0 ? y : -y;
-}
-
-float activate(float v, int act) {
-  if (act == kActLeakyRelu) return v > 0.0 ? v : 0.1 * v;          // LeakyReLU(0.1)
-  if (act == kActRelu) return max(v, 0.0);                     // ReLU
-  if (act == kActGelu) return 0.5 * v * (1.0 + erf_approx(v * 0.70710678118654752)); // exact GELU
-  return v;
-}
+#include "activate.glsl"
 
 void main() {
   const int tx = int(gl_LocalInvocationID.x), ty = int(gl_LocalInvocationID.y);
@@ -59,6 +55,10 @@ void main() {
 #else
   const int M = p.m, N = p.n, K = p.k;
 #endif
+#ifdef WINOGRAD_GEMM
+  const int point = int(gl_WorkGroupID.z);
+  const int a_base = p.w_off + point * M * K, b_base = point * K * N, c_base = point * M * N;
+#endif
 
   float acc[4][4];
   for (int i = 0; i < 4; ++i)
@@ -72,8 +72,10 @@ void main() {
       const int gm = row0 + mm, gk = k0 + kk;
       float v = 0.0;
       if (gm < M && gk < K) {
-#ifdef IMPLICIT_CONV
+#if defined(IMPLICIT_CONV)
         v = float(a_data[p.w_off + gm * K + gk]);
+#elif defined(WINOGRAD_GEMM)
+        v = float(a_data[a_base + gm * K + gk]);
 #else
         v = float(a_data[p.a_off + gm * p.a_rs + gk * p.a_cs]);
 #endif
@@ -95,6 +97,9 @@ void main() {
           v = float(b_data[p.in_off + ci * in_plane + iy * p.in_w + ix]);
         }
       }
+#elif defined(WINOGRAD_GEMM)
+      const int gn = col0 + nn;
+      if (gn < N && gk < K) v = b_data[b_base + gk * N + gn];
 #else
       const int gn = col0 + nn;
       if (gn < N && gk < K) v = float(b_data[p.b_off + gk * p.b_rs + gn * p.b_cs]);
@@ -123,6 +128,11 @@ void main() {
       float v = p.alpha * acc[i][j] + bias;
       if (p.add_off >= 0) v += float(d_data[p.add_off + gm * N + gn]);
       c_data[p.out_off + gm * N + gn] = VALUE(activate(v, p.act));
+    }
+#elif defined(WINOGRAD_GEMM)
+    for (int j = 0; j < 4; ++j) {
+      const int gn = col0 + tx + 16 * j;
+      if (gn < N) c_data[c_base + gm * N + gn] = acc[i][j];
     }
 #else
     const float bias = p.bias_off >= 0 ? float(a_data[p.bias_off + gm]) : 0.0;

@@ -1,0 +1,52 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "precision.glsl"
+// F(4×4, 3×3)'s output transform: for each output channel and 4×4 tile, Aᵀ m A of its 36
+// products, then bias, addend and activation, as the direct convolution applies them.
+#include "common.glsl"
+layout(std430, binding = 0) readonly buffer W { VALUE w[]; };
+layout(std430, binding = 1) readonly buffer Products { float m[]; };
+layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
+layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
+#include "params/winograd_output_params.h"
+#include "activate.glsl"
+
+// Aᵀ applied to six values.
+void output_1d(float m0, float m1, float m2, float m3, float m4, float m5, out float o[4]) {
+  const float sum12 = m1 + m2, diff12 = m1 - m2, sum34 = m3 + m4, diff34 = m3 - m4;
+  o[0] = m0 + sum12 + sum34;
+  o[1] = diff12 + 2.0 * diff34;
+  o[2] = sum12 + 4.0 * sum34;
+  o[3] = diff12 + 8.0 * diff34 + m5;
+}
+
+void main() {
+  const int plane = p.h * p.w;
+  const int stride = p.c * p.tiles;  // between points
+  FOR_EACH(i, p.c * p.tiles) {
+    const int co = i / p.tiles, t = i - co * p.tiles;
+    const int ty = t / p.tiles_x, tx = t - ty * p.tiles_x;
+    float rows[6][4];  // m A: each row of the 6×6 products transformed
+    for (int k = 0; k < 6; ++k) {
+      float o[4];
+      output_1d(m[(6 * k) * stride + i], m[(6 * k + 1) * stride + i], m[(6 * k + 2) * stride + i],
+                m[(6 * k + 3) * stride + i], m[(6 * k + 4) * stride + i], m[(6 * k + 5) * stride + i], o);
+      for (int j = 0; j < 4; ++j) rows[k][j] = o[j];
+    }
+    const float bias = p.bias_off >= 0 ? float(w[p.bias_off + co]) : 0.0;
+    for (int j = 0; j < 4; ++j) {  // Aᵀ (m A): each column
+      float o[4];
+      output_1d(rows[0][j], rows[1][j], rows[2][j], rows[3][j], rows[4][j], rows[5][j], o);
+      const int x = 4 * tx + j;
+      if (x >= p.w) continue;
+      for (int r = 0; r < 4; ++r) {
+        const int y = 4 * ty + r;
+        if (y >= p.h) continue;
+        const int at = co * plane + y * p.w + x;
+        float v = o[r] + bias;
+        if (p.add_off >= 0) v += float(addend[p.add_off + at]);
+        dst[p.out_off + at] = VALUE(activate(v, p.act));
+      }
+    }
+  }
+}
