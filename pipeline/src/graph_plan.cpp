@@ -171,9 +171,13 @@ SinkPlan plan_sink(const std::string& graph, const NamedSink& sink, const PlanCo
       return plan;
     }
     case VideoSink::Target::rtsp:
-      plan.chain = {
-          leaky_queue(p + "queue"), visualizer(p + "viz", v.max_flow), element("videoconvert", p + "convert"),
-          no_preroll(element("intervideosink", p + "inter")).set("channel", rtsp_channel_name(graph, v.rtsp_mount))};
+      // Not synchronised to the clock: a flow leaves the network later than its frame's time,
+      // so a synchronised sink would call most of them late and drop them with a warning; the
+      // server's intervideosrc paces the clients.
+      plan.chain = {leaky_queue(p + "queue"), visualizer(p + "viz", v.max_flow), element("videoconvert", p + "convert"),
+                    no_preroll(element("intervideosink", p + "inter"))
+                        .set("channel", rtsp_channel_name(graph, v.rtsp_mount))
+                        .set("sync", "false")};
       return plan;
     case VideoSink::Target::udp:
       plan.chain = {leaky_queue(p + "queue"),

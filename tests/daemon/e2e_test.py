@@ -380,6 +380,7 @@ class DaemonVideoOut(DaemonTestCase):
         if rtsp.returncode != 0:
             print(f"rtsp client: an error after the EOS (exit {rtsp.returncode}):\n{rtsp.stderr[-1000:]}")
         self.assertEqual(d.stop(), 0)
+        self.assertNotIn("buffers are being dropped", d.log_text())
 
 
     def test_rtsp_credentials_keep_out_who_is_not_listed(self):

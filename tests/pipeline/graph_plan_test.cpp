@@ -77,6 +77,24 @@ TEST(GraphPlan, ADisplaySinkTakesTheWindowSinkOfTheSessionItRunsIn) {
   for (const auto& element : plan_with(DisplayServer::x11).chain) EXPECT_NE(element.factory, "autovideosink");
 }
 
+// A live branch's sink never waits for the clock: flows leave the network later than their
+// frames' times, and a synchronised sink drops the late ones with a warning ("A lot of buffers
+// are being dropped", seven times in 15 s with an RTSP client).
+TEST(GraphPlan, LiveVideoSinksDoNotSynchroniseToTheClock) {
+  PlanContext context;
+  context.display_server = [] { return DisplayServer::x11; };
+  const auto last_sync = [&](const SinkDescription& sink) {
+    const ElementSpec& out = plan_sink("g", {"out", sink}, context).chain.back();
+    for (const auto& [property, value] : out.properties) {
+      if (property == "sync") return value;
+    }
+    return std::string("(unset: true)");
+  };
+  EXPECT_EQ(last_sync(video_to(VideoSink::Target::rtsp)), "false");
+  EXPECT_EQ(last_sync(video_to(VideoSink::Target::udp)), "false");
+  EXPECT_EQ(last_sync(DisplaySink{}), "false");
+}
+
 TEST(GraphPlan, TheDisplayServerComesFromTheEnvironment) {
   const auto saved = [](const char* name) {
     const char* v = std::getenv(name);
