@@ -218,6 +218,8 @@ std::string Daemon::render_metrics() {
     m.inference = s.inference;
     m.flows = s.flows;
     m.uptime_s = s.state == StreamState::playing ? s.seconds_in_state : 0.0;
+    m.stalled = s.state == StreamState::playing && s.seconds_since_progress > kUpWindowS;
+    m.last_flow_unix_s = s.last_flow_unix_s;
     for (const auto& sink : s.sinks) {
       m.sinks.push_back(
           {sink.name, sink.kind, sink.counts_flows, sink.flows_written, sink.bytes_written, sink.failures});

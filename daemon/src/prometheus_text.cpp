@@ -98,9 +98,10 @@ std::string render_prometheus(const std::vector<StreamMetrics>& streams, double 
     for (const auto& s : streams) emit(s, stream_label(s));
   };
 
-  per_stream("neuflow_stream_up", "gauge", "1 while the stream is playing, else 0.",
+  per_stream("neuflow_stream_up", "gauge",
+             "1 while the stream is playing and a frame left the flow element in the last 5 s, else 0.",
              [&](const StreamMetrics& s, const std::string& l) {
-               out.sample(l, std::uint64_t{s.state == "playing" ? 1u : 0u});
+               out.sample(l, std::uint64_t{s.state == "playing" && !s.stalled ? 1u : 0u});
              });
   // Every known state gets a series (0 or 1) so that a state change never makes a series
   // vanish; a state this code does not know is still shown rather than lost.
@@ -141,6 +142,9 @@ std::string render_prometheus(const std::vector<StreamMetrics>& streams, double 
   per_stream("neuflow_stream_uptime_seconds", "gauge",
              "Seconds since the stream last started playing; 0 while it is not playing.",
              [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.uptime_s); });
+  per_stream("neuflow_last_flow_timestamp_seconds", "gauge",
+             "Unix time of the stream's last flow, to a second; 0 before its first.",
+             [&](const StreamMetrics& s, const std::string& l) { out.sample(l, s.last_flow_unix_s); });
   const auto per_sink = [&](const char* name, const char* help, bool counted_only,
                             const std::function<std::uint64_t(const SinkMetrics&)>& value) {
     bool any = false;

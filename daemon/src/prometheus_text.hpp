@@ -33,8 +33,14 @@ struct StreamMetrics {
   std::uint64_t restarts = 0;
   LatencyCounts inference;         // inference time of each flow
   double uptime_s = 0.0;           // since the stream last reached "playing"; 0 when not playing
+  bool stalled = false;            // playing, but no frame has left the flow element for kUpWindowS
+  double last_flow_unix_s = 0.0;   // 0: no flow yet
   std::vector<SinkMetrics> sinks;  // in config order
 };
+
+// A playing stream is "up" while a frame has left the flow element within this many seconds:
+// a stream stuck behind a blocked sink is down long before the stall timeout restarts it.
+inline constexpr double kUpWindowS = 5.0;
 
 // The states render_prometheus reports as neuflow_stream_state series, one each per stream.
 inline constexpr const char* kStreamStates[] = {"playing", "starting", "backoff", "stopped", "finished"};

@@ -79,8 +79,8 @@ const char* to_string(StreamState state) {
 Stream::Stream(StreamConfig config, int threads, DaemonSettings settings, StreamTotals carried)
     : config_(std::move(config)),
       threads_(threads),
-      settings_(settings),
-      backoff_s_(settings.restart_delay_min),
+      settings_(std::move(settings)),
+      backoff_s_(settings_.restart_delay_min),
       base_{carried.frames_in, carried.frames_processed, carried.frames_dropped, carried.flows},
       sink_base_(std::move(carried.sinks)),
       inference_(carried.inference),
@@ -387,6 +387,10 @@ void Stream::tick() {
     last_processed_ = current_.processed;
     last_progress_ = now;
   }
+  if (const std::uint64_t flows = base_.flows + current_.flows; flows != last_flows_) {
+    last_flows_ = flows;
+    last_flow_at_ = std::chrono::system_clock::now();
+  }
   // Frames leaving the flow element mean the stream runs, even while a sink is still waiting
   // for its first buffer (an H.264 encoder's lookahead holds back the pipeline's PLAYING).
   if (state_ == StreamState::starting && current_.processed > 0) mark_playing();
@@ -438,6 +442,10 @@ StreamSnapshot Stream::snapshot() const {
     s.sinks.push_back(std::move(out));
   }
   s.seconds_in_state = seconds_since(state_since_);
+  s.seconds_since_progress = seconds_since(last_progress_);
+  if (last_flows_ > 0) {
+    s.last_flow_unix_s = std::chrono::duration<double>(last_flow_at_.time_since_epoch()).count();
+  }
   if (state_ == StreamState::backoff) {
     s.retry_in_s = seconds_until_restart();
   }

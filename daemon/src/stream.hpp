@@ -37,7 +37,9 @@ struct StreamSnapshot {
   std::uint64_t restarts = 0;
   LatencyCounts inference;  // every flow's inference time, over all runs
   double seconds_in_state = 0;
-  double retry_in_s = 0;  // backoff only
+  double retry_in_s = 0;              // backoff only
+  double seconds_since_progress = 0;  // since a frame last left the flow element (or it began playing)
+  double last_flow_unix_s = 0;        // wall-clock time of the last flow (to a second); 0: none yet
   struct Sink {
     std::string name;
     std::string kind;                 // pipeline::sink_kind()
@@ -140,7 +142,9 @@ class Stream {
   } base_, current_;
   double rate_fps_ = 0;
   std::uint64_t last_processed_ = 0;  // for stall detection
-  std::uint64_t rate_base_ = 0;       // processed count at the last rate measurement
+  std::uint64_t last_flows_ = 0;      // over all runs, when last_flow_at_ was taken
+  std::chrono::system_clock::time_point last_flow_at_{};
+  std::uint64_t rate_base_ = 0;  // processed count at the last rate measurement
   Clock::time_point last_rate_at_{};
   bool rate_known_ = false;  // a rate has been measured in this run
   // Per sink: what finished runs wrote (and failures), and what the running pipeline wrote.

@@ -113,6 +113,14 @@ void StreamGraph::remove_branch(SinkBranch& branch) {
   // Without the branch the pipeline's EOS no longer waits for the failed sink.
   gst_bin_remove(GST_BIN(pipeline_), branch.bin);
   branch.removed = true;
+  // The branch's error, posted while the pipeline was still on its way to PLAYING (a video
+  // sink prerolls only once its encoder has filled its look-ahead), marked that state change
+  // failed: the pipeline would stay PAUSED, its prerolled sinks blocking every branch, and so
+  // the stream. Asked again, the state change goes on without the branch.
+  GST_OBJECT_LOCK(pipeline_);
+  const GstState target = GST_STATE_TARGET(pipeline_);
+  GST_OBJECT_UNLOCK(pipeline_);
+  if (target == GST_STATE_PLAYING || target == GST_STATE_PAUSED) gst_element_set_state(pipeline_, target);
 }
 
 std::unique_ptr<StreamGraph> build_stream_graph(const GraphDescription& description, const std::string& instance) {

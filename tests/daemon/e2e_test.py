@@ -560,6 +560,39 @@ class DaemonFailures(DaemonTestCase):
         self.assertEqual(d.stop(), 0)
 
 
+    def test_a_sink_failing_while_a_video_sink_prerolls_stalls_nothing(self):
+        # The video sink prerolls only once x264enc has filled its look-ahead (dozens of frames):
+        # an error from another sink before then once failed the pipeline's way to PLAYING, and
+        # every branch stalled behind the paused MP4 writer.
+        doomed = os.path.join(self.dir, "doomed")
+        kept = os.path.join(self.dir, "kept")
+        d = self.start(stream_block("s", test_source(), [
+            f'  type = "files"\n  name = "doomed"\n  directory = "{doomed}"',
+            f'  type = "files"\n  name = "kept"\n  directory = "{kept}"',
+            f'  type = "video"\n  file = "{os.path.join(self.dir, "viz.mp4")}"',
+        ]))
+        d.wait_ready(60)
+        deadline = time.monotonic() + 60
+        while not flow_files(doomed) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        deadline = time.monotonic() + 10
+        while os.path.isdir(doomed) and time.monotonic() < deadline:
+            shutil.rmtree(doomed, ignore_errors=True)
+        with open(doomed, "w") as f:
+            f.write("not a folder\n")
+        d.wait_log(r"stream s: sink doomed failed: .*other sinks", timeout=30)
+        self.assertNotIn("sink video", d.log_text())
+        before = len(flow_files(kept))
+        deadline = time.monotonic() + 60
+        while len(flow_files(kept)) < before + 100 and time.monotonic() < deadline:
+            time.sleep(0.2)
+        self.assertGreaterEqual(len(flow_files(kept)), before + 100, d.log_text()[-3000:])
+        self.assertEqual(d.stop(), 0, d.log_text()[-3000:])
+        segments = sorted(f for f in os.listdir(self.dir) if f.startswith("viz") and f.endswith(".mp4"))
+        self.assertEqual(len(segments), 1, segments)
+        self.assertGreater(mp4_decodes(os.path.join(self.dir, segments[0])), 0)
+
+
 class CheckConfig(DaemonTestCase):
     def run_check(self, text):
         path = os.path.join(self.dir, "check.toml")

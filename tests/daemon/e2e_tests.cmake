@@ -34,6 +34,7 @@ foreach(test_case
     DaemonVideoOut.test_rtsp_credentials_keep_out_who_is_not_listed
     DaemonFailures.test_failing_source_restarts_while_other_stream_runs
     DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
+    DaemonFailures.test_a_sink_failing_while_a_video_sink_prerolls_stalls_nothing
     DaemonFailures.test_a_missing_gpu_restarts_its_stream_while_the_others_run
     DaemonFailures.test_a_lost_gpu_restarts_its_stream_on_a_new_device_while_the_others_run
     CheckConfig.test_valid_config_passes

@@ -29,6 +29,7 @@ std::vector<StreamMetrics> known_snapshot() {
   front.restarts = 1;
   for (const double seconds : {0.125, 0.25, 0.5}) front.inference.add(seconds);  // 0.25 is on a bound: le="0.25"
   front.uptime_s = 81.5;
+  front.last_flow_unix_s = 1765012345.5;
   front.sinks = {{"archive", "files", true, 1149, 4711, 0}, {"live", "rtsp", false, 0, 0, 1}};
 
   StreamMetrics odd;
@@ -45,7 +46,7 @@ neuflow_build_info{version="1.2.3"} 1
 # HELP neuflow_daemon_uptime_seconds Seconds since neuflowd started.
 # TYPE neuflow_daemon_uptime_seconds gauge
 neuflow_daemon_uptime_seconds 120.25
-# HELP neuflow_stream_up 1 while the stream is playing, else 0.
+# HELP neuflow_stream_up 1 while the stream is playing and a frame left the flow element in the last 5 s, else 0.
 # TYPE neuflow_stream_up gauge
 neuflow_stream_up{stream="front"} 1
 neuflow_stream_up{stream="odd \"name\"\\ with\nnewline"} 0
@@ -117,6 +118,10 @@ neuflow_inference_seconds_count{stream="odd \"name\"\\ with\nnewline"} 0
 # TYPE neuflow_stream_uptime_seconds gauge
 neuflow_stream_uptime_seconds{stream="front"} 81.5
 neuflow_stream_uptime_seconds{stream="odd \"name\"\\ with\nnewline"} 0
+# HELP neuflow_last_flow_timestamp_seconds Unix time of the stream's last flow, to a second; 0 before its first.
+# TYPE neuflow_last_flow_timestamp_seconds gauge
+neuflow_last_flow_timestamp_seconds{stream="front"} 1765012345.5
+neuflow_last_flow_timestamp_seconds{stream="odd \"name\"\\ with\nnewline"} 0
 # HELP neuflow_sink_flows_written_total Flows the sink wrote (flow files, or flows published into the ring).
 # TYPE neuflow_sink_flows_written_total counter
 neuflow_sink_flows_written_total{stream="front",sink="archive",kind="files"} 1149
@@ -160,6 +165,19 @@ TEST(PrometheusText, FormatsSampleValues) {
   EXPECT_EQ(format_sample_value(std::numeric_limits<double>::quiet_NaN()), "NaN");
   EXPECT_EQ(format_sample_value(std::numeric_limits<double>::infinity()), "+Inf");
   EXPECT_EQ(format_sample_value(-std::numeric_limits<double>::infinity()), "-Inf");
+}
+
+// A stream stuck behind a blocked sink still says "playing" until the stall timeout restarts
+// it; it is not up.
+TEST(PrometheusText, APlayingStreamWithoutFramesIsNotUp) {
+  StreamMetrics s;
+  s.stream = "cam";
+  s.state = "playing";
+  EXPECT_NE(render_prometheus({s}, 1.0, "1.2.3").find("neuflow_stream_up{stream=\"cam\"} 1\n"), std::string::npos);
+  s.stalled = true;
+  const std::string text = render_prometheus({s}, 1.0, "1.2.3");
+  EXPECT_NE(text.find("neuflow_stream_up{stream=\"cam\"} 0\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("neuflow_stream_state{stream=\"cam\",state=\"playing\"} 1\n"), std::string::npos) << text;
 }
 
 TEST(PrometheusText, UnknownStateIsStillReported) {
@@ -288,7 +306,7 @@ TEST(PrometheusText, OutputFollowsTheTextFormatGrammar) {
   const Parsed p = parse_exposition(render_prometheus(snapshot, 3600.0, "0.1.0-dev \"x\""));
   for (const auto& e : p.errors) ADD_FAILURE() << e;
 
-  EXPECT_EQ(p.types.size(), 14u);
+  EXPECT_EQ(p.types.size(), 15u);
   EXPECT_EQ(p.types.at("neuflow_inference_seconds"), "histogram");
   std::set<std::string> streams;
   for (const auto& labels : p.labels) {
