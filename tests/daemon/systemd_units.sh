@@ -109,6 +109,11 @@ case $mode in
       [ -f "$units/$unit" ] || fail "$unit not installed under $units"
       grep -q "^ExecStart=$prefix/bin/neuflowd " "$units/$unit" ||
         fail "$unit: ExecStart= does not start the installed $prefix/bin/neuflowd"
+      # The plugin's folder: GStreamer's own (pkg-config's pluginsdir) under the prefix.
+      gst_prefix=$(pkg-config --variable=prefix gstreamer-1.0)
+      plugins="$prefix/$(pkg-config --variable=pluginsdir gstreamer-1.0 | sed "s|^$gst_prefix/||")"
+      grep -q "^Environment=GST_PLUGIN_PATH_1_0=$plugins\$" "$units/$unit" ||
+        fail "$unit: GST_PLUGIN_PATH_1_0 is not the installed plugin's folder $plugins"
       verify "$units/$unit"
       grep -q '^Group=neuflow$' "$units/$unit" || fail "$unit: not run in the group neuflow"
     done

@@ -1,14 +1,21 @@
 #!/usr/bin/env bash
-# Installs the build into a temporary prefix and checks that GStreamer loads the plugin from
-# there (no build tree on any search path). Usage: install_test.sh BUILD_DIR GST_INSPECT
+# Installs the build into a temporary prefix and checks that the plugin lands in GStreamer's
+# own plugin folder under it (pkg-config's pluginsdir, relative to GStreamer's prefix) and that
+# GStreamer loads it from there (no build tree on any search path).
+# Usage: install_test.sh BUILD_DIR GST_INSPECT PLUGIN_DIR
 set -euo pipefail
 build=$1
 inspect=$2
+plugin_dir=$3
 prefix=$(mktemp -d)
 trap 'rm -rf "$prefix"' EXIT
 cmake --install "$build" --prefix "$prefix" > /dev/null
-plugin=$(find "$prefix" -name libgstneuflow.so | head -n 1)
-[ -n "$plugin" ] || { echo "FAIL: libgstneuflow.so not installed under $prefix"; exit 1; }
+expected=$(pkg-config --variable=pluginsdir gstreamer-1.0)
+gst_prefix=$(pkg-config --variable=prefix gstreamer-1.0)
+[ "$plugin_dir" = "${expected#"$gst_prefix"/}" ] ||
+  { echo "FAIL: the plugin's folder $plugin_dir is not GStreamer's pluginsdir $expected under the prefix"; exit 1; }
+plugin="$prefix/$plugin_dir/libgstneuflow.so"
+[ -f "$plugin" ] || { echo "FAIL: libgstneuflow.so not installed as $plugin"; find "$prefix" -name '*.so'; exit 1; }
 echo "installed: $plugin"
 # gst-inspect's Origin URL and Doc-uri point at the documentation installed beside it.
 for doc in README.md LICENSE docs/benchmarks.md; do
