@@ -49,6 +49,10 @@ ElementSpec h264_encoder(const std::string& name, int bitrate_kbps, bool live) {
   if (live) enc.set("tune", "zerolatency");
   return enc.set("speed-preset", live ? "ultrafast" : "veryfast")
       .set("key-int-max", "30")
+      // Keyframes every key-int-max frames only: a stream's first picture (no flow yet, drawn
+      // white) and the next one (the first flow) looked like a scene cut, and the extra
+      // keyframe left a segmented file's first segment with one frame that did not decode.
+      .set("option-string", "scenecut=0")
       .set("bitrate", std::to_string(bitrate_kbps));
 }
 

@@ -383,6 +383,23 @@ class DaemonVideoOut(DaemonTestCase):
         self.assertNotIn("buffers are being dropped", d.log_text())
 
 
+    def test_every_segment_of_a_live_video_sink_plays(self):
+        # The first frame has no flow (drawn white) and the next is the flow: x264's scene-cut
+        # detection made that a keyframe, and the first segment held one frame that did not
+        # decode (1,823 bytes, 0 frames).
+        d = self.start(stream_block("cam", test_source(), [
+            f'  type = "video"\n  file = "{os.path.join(self.dir, "viz.mp4")}"\n  segment-seconds = 1',
+        ]))
+        d.wait_ready(60)
+        segments = lambda: sorted(f for f in os.listdir(self.dir) if f.startswith("viz") and f.endswith(".mp4"))
+        deadline = time.monotonic() + 60
+        while len(segments()) < 4 and time.monotonic() < deadline:
+            time.sleep(0.2)
+        self.assertEqual(d.stop(), 0, d.log_text()[-3000:])
+        self.assertGreaterEqual(len(segments()), 4, segments())
+        for f in segments():
+            self.assertGreater(mp4_decodes(os.path.join(self.dir, f)), 0, f)
+
     def test_rtsp_credentials_keep_out_who_is_not_listed(self):
         rtsp_port = free_port()
         users = os.path.join(self.dir, "rtsp-users")

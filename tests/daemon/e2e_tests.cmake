@@ -32,6 +32,7 @@ foreach(test_case
     DaemonLifecycle.test_watchdog_and_status
     DaemonVideoOut.test_rtsp_mount_and_rtp_udp_deliver_decodable_h264
     DaemonVideoOut.test_rtsp_credentials_keep_out_who_is_not_listed
+    DaemonVideoOut.test_every_segment_of_a_live_video_sink_plays
     DaemonFailures.test_failing_source_restarts_while_other_stream_runs
     DaemonFailures.test_failing_sink_is_cut_off_and_the_stream_goes_on
     DaemonFailures.test_a_sink_failing_while_a_video_sink_prerolls_stalls_nothing

@@ -175,8 +175,8 @@ TEST(GraphPlan, RtspMediaIsTheChannelEncodedAndPacketized) {
   const std::string line = rtsp_launch_line(channel, 1500);
   EXPECT_EQ(line,
             "( intervideosrc channel=\"neuflowd/front/live\" ! videoconvert ! video/x-raw,format=I420 ! x264enc "
-            "tune=zerolatency speed-preset=ultrafast key-int-max=30 bitrate=1500 ! rtph264pay name=pay0 pt=96 "
-            "config-interval=1 )");
+            "tune=zerolatency speed-preset=ultrafast key-int-max=30 option-string=\"scenecut=0\" bitrate=1500 ! "
+            "rtph264pay name=pay0 pt=96 config-interval=1 )");
   // GStreamer reads it back as the server will (when the elements are installed here).
   gst_init(nullptr, nullptr);
   for (const char* factory : {"intervideosrc", "x264enc", "rtph264pay"}) {
