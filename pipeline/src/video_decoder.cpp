@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "gst_support.hpp"
+#include "network_host.hpp"
 #include "neuflow/pipeline/pipeline_error.hpp"
 
 namespace neuflow::pipeline {
@@ -54,6 +55,7 @@ std::string to_uri(const std::string& source) {
 
 struct VideoDecoder::Impl {
   std::string source;
+  std::string uri;  // what uridecodebin opens
   GstPtr<GstElement> pipeline;
   GstElement* convert = nullptr;  // owned by the pipeline
   GstElement* sink = nullptr;     // owned by the pipeline
@@ -114,7 +116,8 @@ VideoDecoder::VideoDecoder(const std::string& source, std::chrono::milliseconds 
   auto& s = *impl_;
   s.source = source;
   s.start_timeout = start_timeout;
-  const std::string uri = to_uri(source);
+  s.uri = to_uri(source);
+  const std::string& uri = s.uri;
 
   s.pipeline.reset(GST_ELEMENT(gst_object_ref_sink(gst_pipeline_new("neuflow-decoder"))));
   GstElement* decode = detail::make_element("uridecodebin", source);
@@ -144,6 +147,7 @@ VideoDecoder::VideoDecoder(const std::string& source, std::chrono::milliseconds 
     const auto error = detail::pop_bus_error(s.bus.get());
     gst_element_set_state(s.pipeline.get(), GST_STATE_NULL);
     if (!error) throw PipelineError(Kind::undecodable, source, "GStreamer cannot start decoding it");
+    if (auto host = detail::unresolvable_host(s.uri)) throw PipelineError(Kind::not_found, source, *host);
     throw PipelineError(error->resource ? Kind::not_found : Kind::undecodable, source, error->text);
   }
 }
@@ -174,6 +178,7 @@ std::optional<RgbFrame> VideoDecoder::next() {
     // Frames decoded before a failure have been handed out by now; the failure comes next.
     if (s.no_video) s.fail(Kind::undecodable, "has no video stream");
     if (const auto error = detail::pop_bus_error(s.bus.get())) {
+      if (auto host = detail::unresolvable_host(s.uri)) s.fail(Kind::not_found, *host);
       s.fail(error->resource ? Kind::not_found : Kind::undecodable, error->text);
     }
     if (gst_app_sink_is_eos(GST_APP_SINK(s.sink))) {

@@ -98,6 +98,15 @@ PipelineError decode_failure(const std::string& source,
   return PipelineError(PipelineError::Kind::failed, source, "none");
 }
 
+// souphttpsrc says only "Internal data stream error" for a host that does not resolve; the
+// error names the host instead (.invalid never resolves: RFC 6761).
+TEST(VideoDecoder, AnUnknownHostIsNamed) {
+  const PipelineError e = decode_failure("http://no-such-camera.invalid/stream.mp4");
+  EXPECT_EQ(e.kind(), PipelineError::Kind::not_found);
+  EXPECT_NE(std::string(e.what()).find("cannot resolve the host 'no-such-camera.invalid'"), std::string::npos)
+      << e.what();
+}
+
 TEST(VideoDecoder, TextFileIsUndecodable) {
   TempDir dir;
   const auto path = dir / "notes.mp4";
