@@ -133,7 +133,7 @@ TEST(VideoDecoder, TruncatedVideoIsUndecodable) {
 TEST(VideoDecoder, EmptyFileIsUndecodable) {
   TempDir dir;
   const auto path = dir / "empty.mp4";
-  std::ofstream{path};
+  std::ofstream(path).close();  // created empty
   const auto e = decode_failure(path.string(), std::chrono::milliseconds(1500));
   EXPECT_EQ(e.kind(), PipelineError::Kind::undecodable) << e.what();
   EXPECT_EQ(e.subject(), path.string());
