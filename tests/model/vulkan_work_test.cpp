@@ -27,10 +27,10 @@ struct Budget {
 };
 // Every convolution by the direct implicit GEMM (NEUFLOW_VULKAN_CONV=direct): 75.0 MB, most of
 // it weights (the 1/8 refinement reads its own at every step).
-constexpr Budget kDirect{176, 174, 75.1e6};
+constexpr Budget kDirect{165, 163, 75.1e6};
 // The stride-1 3×3 ones by Winograd: three dispatches each, transformed filters four times the
 // size of the filters (260.5 MB at this size, where weights dominate), tiles and products in fp32.
-constexpr Budget kWinograd{358, 352, 261e6};
+constexpr Budget kWinograd{347, 341, 261e6};
 
 class VulkanWork : public ::testing::Test {
  protected:
@@ -98,7 +98,7 @@ TEST_F(VulkanWork, AStreamedFrameIsCountedCommandByCommand) {
   // The convolutions' and products' multiply-adds are the network's arithmetic as
   // network_cost() counts it from the architecture table (the attention's and matching's
   // products included), which shares nothing with the recorder's count.
-  const double counted = static_cast<double>(multiply_adds_of(work, {"conv2d", "matmul"}));
+  const double counted = static_cast<double>(multiply_adds_of(work, {"conv2d", "matmul", "flash_attention"}));
   const double expected = network_cost(kHeight, kWidth).stream_frame() / 2;
   EXPECT_NEAR(counted, expected, expected * 1e-12);
   expect_within(work, kDirect);
@@ -163,7 +163,7 @@ TEST_F(VulkanWork, Fp16HalvesTheTensorsBytes) {
     EXPECT_EQ(x.bytes_written, 2 * y.bytes_written) << x.kernel << " in " << x.stage;
     ++halved;
   }
-  EXPECT_GT(halved, 90);
+  EXPECT_GT(halved, 80);
 }
 
 TEST_F(VulkanWork, AnObservedPassIsNotCounted) {

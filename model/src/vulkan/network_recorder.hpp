@@ -173,6 +173,23 @@ class VulkanNetwork::Recorder {
                              tiles(p.n, "attention"), tiles(p.m, "attention"));
   }
 
+  // out = softmax(alpha · qᵀ k) · vᵀ per query token (flash_attention.comp), less v at the
+  // query's own token where `subtract_own_value`.
+  void flash_attention(const View& q, const View& k, const View& v, const View& out, float alpha,
+                       bool subtract_own_value) {
+    const long long tokens = static_cast<long long>(q.h) * q.w;
+    if (q.c > kFlashAttentionMaxChannels || v.c > kFlashAttentionMaxChannels) {
+      throw std::logic_error("the Vulkan attention takes at most " + std::to_string(kFlashAttentionMaxChannels) +
+                             " channels");
+    }
+    const FlashAttentionParams p{static_cast<int>(tokens), q.c, v.c, q.offset(), k.offset(), v.offset(),
+                                 out.offset(), subtract_own_value ? 1 : 0, alpha};
+    dispatch<Shader::flash_attention>({q.buffer, k.buffer, out.buffer, v.buffer}, p,
+                                      {bytes(q.count() + k.count() + v.count()), bytes(out.count()),
+                                       tokens * tokens * (q.c + v.c)},
+                                      groups(tokens, 64));
+  }
+
   // The pass's frames: the slot that holds the frame each graph::FrameRole names (-1: none).
   void bind_frames(std::array<int, 3> slots) { frames_ = slots; }
   // An encode pass's source: an 8-bit frame in the upload (its layout), or nullptr for floats.

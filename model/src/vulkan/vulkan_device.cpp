@@ -73,7 +73,8 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
                                                             " (0 to " + std::to_string(devices.size() - 1) +
                                                             "; `neuflow devices` lists them)");
   }
-  // What the shaders need: Vulkan 1.1 SPIR-V, workgroups of 256 invocations (16×16 tiles).
+  // What the shaders need: Vulkan 1.1 SPIR-V, workgroups of 256 invocations (16×16 tiles), and
+  // up to 10 KiB of shared memory (flash_attention.comp).
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(devices[static_cast<std::size_t>(index)], &props);
   const std::string label = "vulkan device " + std::to_string(index) + " (" + props.deviceName + ")";
@@ -81,11 +82,11 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
     throw BackendError(BackendError::Kind::unavailable, label + ": supports only Vulkan 1.0; the shaders need 1.1");
   }
   if (props.limits.maxComputeWorkGroupInvocations < 256 || props.limits.maxComputeWorkGroupSize[0] < 256 ||
-      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 8192) {
+      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 16384) {
     throw BackendError(BackendError::Kind::unavailable,
                        label +
                            ": compute workgroups are too small for the shaders (they need 256 invocations and "
-                           "8 KiB of shared memory)");
+                           "16 KiB of shared memory, Vulkan's minimum)");
   }
   const std::lock_guard lock(mutex);
   if (auto device = opened[index].lock(); device && !device->lost_) return device;
