@@ -10,6 +10,9 @@
 #include "vulkan/shaders.hpp"
 #include "vulkan/vulkan_device.hpp"
 
+#include <chrono>
+#include <cstdio>
+
 namespace neuflow::model::vulkan {
 namespace {
 
@@ -18,10 +21,16 @@ TEST(VulkanPipelines, EveryShaderInBothPrecisionsIsAcceptedByTheDriverAndTheVali
   const auto device = VulkanDevice::open(0);
   for (std::size_t i = 0; i < kShaderCount; ++i) {
     const auto shader = static_cast<Shader>(i);
+    const auto t0 = std::chrono::steady_clock::now();
     EXPECT_NE(device->pipeline(shader, false), VK_NULL_HANDLE) << shader_name(shader);
+    const auto t1 = std::chrono::steady_clock::now();
     if (device->info().fp16) {
       EXPECT_NE(device->pipeline(shader, true), VK_NULL_HANDLE) << shader_name(shader) << " (fp16)";
     }
+    // What each pipeline costs the driver to create, once per process (lavapipe compiles then).
+    std::printf("%-20s %7.1f ms, fp16 %7.1f ms\n", shader_name(shader),
+                std::chrono::duration<double, std::milli>(t1 - t0).count(),
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
   }
   NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES();
 }

@@ -182,12 +182,13 @@ class VulkanNetwork::Recorder {
       throw std::logic_error("the Vulkan attention takes at most " + std::to_string(kFlashAttentionMaxChannels) +
                              " channels");
     }
-    const FlashAttentionParams p{static_cast<int>(tokens), q.c, v.c, q.offset(), k.offset(), v.offset(),
-                                 out.offset(), subtract_own_value ? 1 : 0, alpha};
-    dispatch<Shader::flash_attention>({q.buffer, k.buffer, out.buffer, v.buffer}, p,
-                                      {bytes(q.count() + k.count() + v.count()), bytes(out.count()),
-                                       tokens * tokens * (q.c + v.c)},
-                                      groups(tokens, 64));
+    const FlashAttentionParams p{
+        static_cast<int>(tokens),   q.c,  v.c, q.offset(), k.offset(), v.offset(), out.offset(),
+        subtract_own_value ? 1 : 0, alpha};
+    dispatch<Shader::flash_attention>(
+        {q.buffer, k.buffer, out.buffer, v.buffer}, p,
+        {bytes(q.count() + k.count() + v.count()), bytes(out.count()), tokens * tokens * (q.c + v.c)},
+        groups(tokens, 64));
   }
 
   // The pass's frames: the slot that holds the frame each graph::FrameRole names (-1: none).

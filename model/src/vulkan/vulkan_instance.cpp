@@ -15,6 +15,12 @@ namespace {
 
 std::atomic<std::size_t> validation_messages{0};
 
+// NEUFLOW_VULKAN_VALIDATION=sync: synchronization validation as well (slower).
+bool synchronization_validation_requested() {
+  const char* v = std::getenv("NEUFLOW_VULKAN_VALIDATION");
+  return v != nullptr && std::strcmp(v, "sync") == 0;
+}
+
 bool validation_requested() {
   const char* v = std::getenv("NEUFLOW_VULKAN_VALIDATION");
   return v != nullptr && *v != '\0' && std::strcmp(v, "0") != 0;
@@ -84,7 +90,7 @@ Instance create_instance() {
     info.ppEnabledExtensionNames = extensions.data();
     // Synchronization validation too: the recorder leaves out the barriers between commands
     // that do not depend on each other, and this is what reports one it left out wrongly.
-    info.pNext = &features;
+    if (synchronization_validation_requested()) info.pNext = &features;
   }
   Instance inst;
   const VkResult r = vkCreateInstance(&info, nullptr, &inst.handle);

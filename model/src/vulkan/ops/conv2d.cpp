@@ -49,7 +49,7 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
   const DeviceConv& w = *op.weights;
   const View in = r.view(op.in), out = r.view(op.out);
   const View addend = op.addend ? r.view(*op.addend) : View{};
-  if (takes_winograd(r.device_weights(), op)) {
+  if (takes_winograd(r.device_weights(), op, out.h, out.w)) {
     record_winograd(r, op, in, out, addend);
     return;
   }
