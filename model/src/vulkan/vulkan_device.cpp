@@ -227,9 +227,9 @@ void VulkanDevice::check(VkResult result, std::string_view call) const {
 }
 
 uint32_t VulkanDevice::memory_type(uint32_t allowed, Memory memory) const {
-  const VkMemoryPropertyFlags want = memory == Memory::device ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
-                                     : memory == Memory::upload
-                                         ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+  // Uploads and read-backs alike: memory the host maps, coherent.
+  const VkMemoryPropertyFlags want = memory == Memory::device
+                                         ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
                                          : VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
   // Read-backs prefer cached memory (reads from write-combined memory are slow).
   const VkMemoryPropertyFlags prefer = memory == Memory::readback ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : 0;
