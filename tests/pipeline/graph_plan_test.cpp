@@ -84,8 +84,8 @@ TEST(GraphPlan, LiveVideoSinksDoNotSynchroniseToTheClock) {
   PlanContext context;
   context.display_server = [] { return DisplayServer::x11; };
   const auto last_sync = [&](const SinkDescription& sink) {
-    const ElementSpec& out = plan_sink("g", {"out", sink}, context).chain.back();
-    for (const auto& [property, value] : out.properties) {
+    const SinkPlan plan = plan_sink("g", {"out", sink}, context);
+    for (const auto& [property, value] : plan.chain.back().properties) {
       if (property == "sync") return value;
     }
     return std::string("(unset: true)");

@@ -68,7 +68,7 @@ Buffer upload_values(VulkanDevice& device, const std::vector<float>& values, boo
   if (fp16) {
     auto* out = static_cast<std::uint16_t*>(static_cast<void*>(staging.mapped()));
     for (std::size_t i = 0; i < values.size(); ++i) out[i] = to_half(values[i]);
-  } else {
+  } else if (!values.empty()) {  // none: direct convolutions have no transformed filters
     std::memcpy(staging.mapped(), values.data(), values.size() * sizeof(float));
   }
   OneShotCommands commands(device);
