@@ -186,6 +186,16 @@ def mp4_decodes(path):
     return out.stdout.count("chain")
 
 
+def break_folder(folder):
+    """The folder disappears under a sink and a file takes its place: every write fails, even for
+    root. The sink may create a temporary file in it while rmtree runs: removed until it is gone."""
+    deadline = time.monotonic() + 10
+    while os.path.isdir(folder) and time.monotonic() < deadline:
+        shutil.rmtree(folder, ignore_errors=True)
+    with open(folder, "w") as f:
+        f.write("not a folder\n")
+
+
 def stream_block(name, source, sinks, behaviour="live", flow=""):
     text = f"""
 [[stream]]
@@ -559,14 +569,7 @@ class DaemonFailures(DaemonTestCase):
         deadline = time.monotonic() + 60
         while len(flow_files(doomed)) < 2 and time.monotonic() < deadline:
             time.sleep(0.2)
-        # The folder disappears under the sink and a file takes its place: every write fails,
-        # even for root.
-        # The sink may create a temporary file in it while rmtree runs: remove until it is gone.
-        deadline = time.monotonic() + 10
-        while os.path.isdir(doomed) and time.monotonic() < deadline:
-            shutil.rmtree(doomed, ignore_errors=True)
-        with open(doomed, "w") as f:
-            f.write("not a folder\n")
+        break_folder(doomed)
         d.wait_log(r"stream s: sink doomed failed: .*other sinks", timeout=30)
         before = len(flow_files(kept))
         deadline = time.monotonic() + 30
@@ -592,11 +595,7 @@ class DaemonFailures(DaemonTestCase):
         deadline = time.monotonic() + 60
         while not flow_files(doomed) and time.monotonic() < deadline:
             time.sleep(0.05)
-        deadline = time.monotonic() + 10
-        while os.path.isdir(doomed) and time.monotonic() < deadline:
-            shutil.rmtree(doomed, ignore_errors=True)
-        with open(doomed, "w") as f:
-            f.write("not a folder\n")
+        break_folder(doomed)
         d.wait_log(r"stream s: sink doomed failed: .*other sinks", timeout=30)
         self.assertNotIn("sink video", d.log_text())
         before = len(flow_files(kept))
