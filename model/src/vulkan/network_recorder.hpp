@@ -166,13 +166,6 @@ class VulkanNetwork::Recorder {
         {0, static_cast<VkDeviceSize>(dst.offset()) * net_.elem_, static_cast<VkDeviceSize>(dst.count()) * net_.elem_});
   }
 
-  // c = a · b (m×k by k×n).
-  void matmul(const Buffer& a, const Buffer& b, const Buffer& c, const MatmulParams& p) {
-    const long long m = p.m, n = p.n, k = p.k;
-    dispatch<Shader::matmul>({&a, &b, &c, nullptr}, p, {bytes(m * k + k * n), bytes(m * n), m * n * k},
-                             tiles(p.n, "attention"), tiles(p.m, "attention"));
-  }
-
   // out = softmax(alpha · qᵀ k) · vᵀ per query token (flash_attention.comp), less v at the
   // query's own token where `subtract_own_value`.
   void flash_attention(const View& q, const View& k, const View& v, const View& out, float alpha,
