@@ -3,10 +3,14 @@
 # registry the C++ side uses (the Shader enum, its count, the SPIR-V tables and each shader's
 # push-constant struct), so adding a shader is one line of CMake and one params header.
 #
-#   neuflow_shader(<name> SOURCE <file.comp> [DEFINES <macro>...])
+#   neuflow_shader(<name> SOURCE <file.comp> [DEFINES <macro>...] [PARAMS <shader>] [FP16_ONLY]
+#                  [TENSOR_CORES])
 #     compiles <file.comp> (with -D<macro>...) into <name>.spv.inc and <name>_fp16.spv.inc (-DFP16:
 #     tensors stored as float16_t, precision.glsl). Its push constants are declared once, in
-#     shaders/params/<name>_params.h as the struct <Name>Params (snake case to camel case).
+#     shaders/params/<name>_params.h as the struct <Name>Params (snake case to camel case), or
+#     are those of the shader PARAMS names (a variant of it, recorded in its place).
+#     FP16_ONLY: only the fp16 variant exists (its fp32 SPIR-V is empty). TENSOR_CORES: it needs
+#     VK_NV_cooperative_matrix (GpuDevice::tensor_cores); its pipelines are made only there.
 #   neuflow_shader_registry(<target>)
 #     writes shader_registry.hpp/.cpp into the shader output folder and adds them to <target>.
 #
@@ -29,17 +33,24 @@ function(neuflow_shader_struct_name name out)
 endfunction()
 
 function(neuflow_shader name)
-  cmake_parse_arguments(ARG "" "SOURCE" "DEFINES" ${ARGN})
+  cmake_parse_arguments(ARG "FP16_ONLY;TENSOR_CORES" "SOURCE;PARAMS" "DEFINES" ${ARGN})
   if(NOT ARG_SOURCE)
     message(FATAL_ERROR "neuflow_shader(${name}): SOURCE <file.comp> is required")
   endif()
-  set(params ${shader_dir}/params/${name}_params.h)
+  if(NOT ARG_PARAMS)
+    set(ARG_PARAMS ${name})
+  endif()
+  set(params ${shader_dir}/params/${ARG_PARAMS}_params.h)
   if(NOT EXISTS ${params})
     message(FATAL_ERROR "neuflow_shader(${name}): its push constants belong in ${params} (see params/interface.h)")
   endif()
   file(GLOB interface_headers ${shader_dir}/*.glsl ${shader_dir}/params/*.h)
   set(outputs)
-  foreach(variant IN ITEMS "" "_fp16")
+  set(variants "" "_fp16")
+  if(ARG_FP16_ONLY)
+    set(variants "_fp16")
+  endif()
+  foreach(variant IN LISTS variants)
     set(defines)
     foreach(d IN LISTS ARG_DEFINES)
       list(APPEND defines -D${d})
@@ -57,6 +68,9 @@ function(neuflow_shader name)
     list(APPEND outputs ${shader_out}/${name}${variant}.spv.inc)
   endforeach()
   set_property(GLOBAL APPEND PROPERTY neuflow_shader_names ${name})
+  set_property(GLOBAL PROPERTY neuflow_shader_params_${name} ${ARG_PARAMS})
+  set_property(GLOBAL PROPERTY neuflow_shader_fp16_only_${name} ${ARG_FP16_ONLY})
+  set_property(GLOBAL PROPERTY neuflow_shader_tensor_cores_${name} ${ARG_TENSOR_CORES})
   set_property(GLOBAL APPEND PROPERTY neuflow_shader_outputs ${outputs})
 endfunction()
 
@@ -70,18 +84,34 @@ function(neuflow_shader_registry target)
   set(tables "")
   set(entries "")
   foreach(name IN LISTS names)
-    neuflow_shader_struct_name(${name} params)
+    get_property(params_of GLOBAL PROPERTY neuflow_shader_params_${name})
+    get_property(fp16_only GLOBAL PROPERTY neuflow_shader_fp16_only_${name})
+    get_property(tensor_cores GLOBAL PROPERTY neuflow_shader_tensor_cores_${name})
+    neuflow_shader_struct_name(${params_of} params)
     string(APPEND enumerators "  ${name},\n")
-    string(APPEND includes "#include \"params/${name}_params.h\"\n")
+    string(APPEND includes "#include \"params/${params_of}_params.h\"\n")
     string(APPEND traits "template <>\nstruct ShaderParams<Shader::${name}> {\n  using type = ${params};\n};\n")
-    string(APPEND tables "constexpr std::uint32_t k_${name}[] = {\n#include \"${name}.spv.inc\"\n};\n"
-                         "constexpr std::uint32_t k_${name}_fp16[] = {\n#include \"${name}_fp16.spv.inc\"\n};\n"
+    string(APPEND tables "constexpr std::uint32_t k_${name}_fp16[] = {\n#include \"${name}_fp16.spv.inc\"\n};\n"
                          "static_assert(sizeof(${params}) <= kMaxPushConstantBytes, \"${name}: push constants over the limit\");\n"
-                         "static_assert(spirv_reflect::push_constant_bytes(k_${name}) == sizeof(${params}) &&\n"
-                         "              spirv_reflect::push_constant_bytes(k_${name}_fp16) == sizeof(${params}),\n"
-                         "              \"${name}: the compiled shader's push-constant block is not ${params} (shaders/params/${name}_params.h)\");\n")
-    string(APPEND entries "    {\"${name}\", k_${name}, k_${name}_fp16, \"${params}\", sizeof(${params}),\n"
-                          "     spirv_reflect::binding_accesses<kShaderBindings>(k_${name})},\n")
+                         "static_assert(spirv_reflect::push_constant_bytes(k_${name}_fp16) == sizeof(${params}),\n"
+                         "              \"${name}: the compiled shader's push-constant block is not ${params} (shaders/params/${params_of}_params.h)\");\n")
+    if(fp16_only)
+      set(fp32_table "{}")
+      set(reflected k_${name}_fp16)
+    else()
+      string(APPEND tables "constexpr std::uint32_t k_${name}[] = {\n#include \"${name}.spv.inc\"\n};\n"
+                           "static_assert(spirv_reflect::push_constant_bytes(k_${name}) == sizeof(${params}),\n"
+                           "              \"${name}: the compiled shader's push-constant block is not ${params} (shaders/params/${params_of}_params.h)\");\n")
+      set(fp32_table k_${name})
+      set(reflected k_${name})
+    endif()
+    if(tensor_cores)
+      set(tensor_cores_value true)
+    else()
+      set(tensor_cores_value false)
+    endif()
+    string(APPEND entries "    {\"${name}\", ${fp32_table}, k_${name}_fp16, \"${params}\", sizeof(${params}),\n"
+                          "     spirv_reflect::binding_accesses<kShaderBindings>(${reflected}), ${tensor_cores_value}},\n")
   endforeach()
   set(generated "// Generated by cmake/NeuflowShaders.cmake from model/CMakeLists.txt's shader list: do not edit.")
   file(CONFIGURE OUTPUT ${shader_out}/shader_registry.hpp @ONLY CONTENT

@@ -45,7 +45,7 @@ keyring_sha256=0d0e7ed6b112f5d03eabf3c7eb01ebdacf9c57714b279e90495cfc58c8c4520f
 jammy_packages=(
   build-essential cmake ninja-build pkg-config git file
   libdnnl-dev
-  libvulkan-dev libvulkan-volk-dev glslang-tools mesa-vulkan-drivers vulkan-validationlayers
+  libvulkan-dev libvulkan-volk-dev glslang-tools spirv-tools mesa-vulkan-drivers vulkan-validationlayers
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-video-dev
   libzip-dev libpng-dev libcli11-dev
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev

@@ -8,7 +8,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libdnnl-dev                       # oneDNN: convolutions and matrix products
-  libvulkan-dev libvulkan-volk-dev glslc   # the Vulkan backend: headers, run-time loader, shader compiler
+  libvulkan-dev libvulkan-volk-dev glslc spirv-tools   # the Vulkan backend: headers, run-time loader, shader compiler, spirv-val
   mesa-vulkan-drivers vulkan-validationlayers vulkan-tools   # its tests: lavapipe, validation, vulkaninfo
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-video-dev
   libzip-dev                        # the zip container of PyTorch checkpoints

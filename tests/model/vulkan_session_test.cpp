@@ -21,6 +21,7 @@
 #include "neuflow/model/gpu_devices.hpp"
 #include "support/camera_frames.hpp"
 #include "support/fixtures.hpp"
+#include "support/flow_error.hpp"
 #include "support/vulkan.hpp"
 
 namespace neuflow::model {
@@ -49,34 +50,6 @@ Errors compare(const flow::FlowField& a, const flow::FlowField& b) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
   return compare(a.uv.data(), b.uv.data(), std::min(a.uv.size(), b.uv.size()));
-}
-
-// fp16's end-point error against fp32, printed; its bound is relative to the flow's size.
-struct Fp16Error {
-  double epe = 0, worst = 0;          // mean and largest end-point error, px
-  double magnitude = 0, largest = 0;  // mean and largest |flow| in fp32, px
-};
-
-Fp16Error fp16_error(const flow::FlowField& exact, const flow::FlowField& half, int w, int h) {
-  Fp16Error r;
-  const std::size_t n = exact.pixel_count();
-  EXPECT_EQ(half.pixel_count(), n);
-  for (std::size_t p = 0; p < n && p < half.pixel_count(); ++p) {
-    const double du = half.uv[2 * p] - exact.uv[2 * p], dv = half.uv[2 * p + 1] - exact.uv[2 * p + 1];
-    const double e = std::sqrt(du * du + dv * dv);
-    const double m = std::hypot(static_cast<double>(exact.uv[2 * p]), static_cast<double>(exact.uv[2 * p + 1]));
-    r.epe += e;
-    r.magnitude += m;
-    r.worst = std::max(r.worst, e);
-    r.largest = std::max(r.largest, m);
-  }
-  r.epe /= static_cast<double>(std::max<std::size_t>(n, 1));
-  r.magnitude /= static_cast<double>(std::max<std::size_t>(n, 1));
-  std::printf(
-      "fp16 vs fp32 at %dx%d: mean EPE %.4f px (%.3f %% of the mean |flow| %.2f px), max %.4f px "
-      "(%.3f %% of the largest |flow| %.2f px)\n",
-      w, h, r.epe, 100 * r.epe / r.magnitude, r.magnitude, r.worst, 100 * r.worst / r.largest, r.largest);
-  return r;
 }
 
 class VulkanSession : public ::testing::Test {
@@ -452,8 +425,8 @@ TEST_F(VulkanSession, Fp16StaysWithinItsBoundOfFp32) {
     cv::Mat a, b;
     cv::resize(frames_[0], a, cv::Size(w, h));
     cv::resize(frames_[1], b, cv::Size(w, h));
-    const Fp16Error e =
-        fp16_error(fp32_session.compute(view_of(a), view_of(b)), fp16_session.compute(view_of(a), view_of(b)), w, h);
+    const test::Fp16Error e = test::fp16_error(fp32_session.compute(view_of(a), view_of(b)),
+                                               fp16_session.compute(view_of(a), view_of(b)), w, h);
     RecordProperty("fp16_mean_epe_" + std::to_string(w) + "x" + std::to_string(h), std::to_string(e.epe));
     EXPECT_LT(e.epe, 0.005 * e.magnitude) << w << "x" << h;
     EXPECT_LT(e.worst, 0.01 * e.largest) << w << "x" << h;
@@ -539,7 +512,7 @@ TEST_F(VulkanSession, OnARealGpuAutoTakesItAndGivesTheCpusFlow) {
   if (!gpu->fp16) return;
   FlowSession half(model_, {.iterations = iterations, .backend = Backend::automatic, .precision = Precision::fp16});
   EXPECT_NE(half.backend_description().find(", fp16"), std::string::npos) << half.backend_description();
-  const Fp16Error f = fp16_error(exact, half.compute(view_of(a), view_of(b)), 768, 432);
+  const test::Fp16Error f = test::fp16_error(exact, half.compute(view_of(a), view_of(b)), 768, 432);
   EXPECT_LT(f.epe, 0.005 * f.magnitude);
   EXPECT_LT(f.worst, 0.01 * f.largest);
 }

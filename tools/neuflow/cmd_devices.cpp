@@ -35,6 +35,7 @@ void run_devices() {
                 static_cast<unsigned long long>(d.memory_bytes >> 20),
                 static_cast<unsigned long long>(d.max_buffer_bytes >> 20));
     std::printf("   fp16: %s\n", d.fp16 ? "yes (shaderFloat16, 16-bit storage)" : "no");
+    std::printf("   tensor cores: %s\n", d.tensor_cores ? "yes (VK_NV_cooperative_matrix, fp16 products)" : "no");
     std::printf("   stage timestamps: %s\n", d.timestamps ? "yes (neuflow-bench-core's vulkan_stream_stages)" : "no");
   }
   if (first_gpu < 0) std::printf("no GPU: --backend auto runs on the CPU\n");

@@ -127,6 +127,14 @@ class VulkanNetwork::Recorder {
     record_dispatch(S, bindings, &push, sizeof push, work, {gx, gy, gz});
   }
 
+  // A product (conv2d, matmul or winograd_gemm) on the kernels the network runs its products
+  // on (product_kernels.hpp): every variant takes the scalar shader's parameters and grid.
+  template <Shader S>
+  void product(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, const Work& work,
+               uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
+    record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work, {gx, gy, gz});
+  }
+
   void record_dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
                        const Work& work, std::array<uint32_t, 3> grid) {
     std::array<VkBuffer, 4> handles{};

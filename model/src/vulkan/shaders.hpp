@@ -20,12 +20,14 @@ inline constexpr std::size_t kShaderBindings = 4;
 
 struct ShaderInfo {
   const char* name;
-  std::span<const std::uint32_t> spirv;
+  std::span<const std::uint32_t> spirv;       // empty for a shader that exists only in fp16
   std::span<const std::uint32_t> spirv_fp16;  // tensors stored as float16_t (precision.glsl)
   const char* params;                         // its push-constant struct (shaders/params/)
   std::size_t params_bytes;
   // What it does with each binding, from its SPIR-V: the recorder's barriers follow it.
   std::array<spirv_reflect::BindingAccess, kShaderBindings> bindings;
+  // Needs VK_NV_cooperative_matrix (GpuDevice::tensor_cores): its pipelines exist only there.
+  bool tensor_cores;
 };
 
 }  // namespace neuflow::model::vulkan

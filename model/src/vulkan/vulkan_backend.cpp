@@ -9,6 +9,7 @@ namespace neuflow::model {
 
 struct VulkanContext {
   std::shared_ptr<const vulkan::DeviceWeights> weights;
+  vulkan::ProductKernels products = vulkan::ProductKernels::scalar;
 };
 
 namespace {
@@ -16,7 +17,7 @@ namespace {
 class VulkanBackend final : public InferenceBackend {
  public:
   VulkanBackend(std::shared_ptr<VulkanContext> context, int height, int width)
-      : context_(std::move(context)), network_(context_->weights, height, width) {}
+      : context_(std::move(context)), network_(context_->weights, height, width, context_->products) {}
   int width() const override { return network_.width(); }
   int height() const override { return network_.height(); }
   void encode(const Tensor& image, int slot) override { network_.encode(image, slot); }
@@ -75,16 +76,23 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
            " has no shaderFloat16 and 16-bit storage (Vulkan 1.2); running in fp32 instead";
     fp16 = false;
   }
-  if (fp16) {  // created now, so a driver that refuses one says so before the first frame
-    for (std::size_t s = 0; s < vulkan::kShaderCount; ++s) device->pipeline(static_cast<vulkan::Shader>(s), true);
-  }
   auto context = std::make_shared<VulkanContext>();
+  context->products = vulkan::product_kernels_for(device->info(), fp16);
+  if (fp16) {  // created now, so a driver that refuses one says so before the first frame
+    for (std::size_t s = 0; s < vulkan::kShaderCount; ++s) {
+      const auto shader = static_cast<vulkan::Shader>(s);
+      if (device->can_run(shader, true)) device->pipeline(shader, true);
+    }
+  }
   context->weights = vulkan::DeviceWeights::get(model, device, fp16, vulkan::winograd_from_environment());
   return context;
 }
 
 std::string describe(const VulkanContext& context) {
-  return context.weights->device->label() + (context.weights->fp16 ? ", fp16" : "");
+  std::string text = context.weights->device->label() + (context.weights->fp16 ? ", fp16" : "");
+  if (context.products == vulkan::ProductKernels::tensor_cores) text += ", tensor cores";
+  if (context.products == vulkan::ProductKernels::twin) text += ", tensor cores emulated";
+  return text;
 }
 
 std::unique_ptr<InferenceBackend> make_vulkan_backend(const std::shared_ptr<VulkanContext>& context, int height,

@@ -15,7 +15,8 @@ struct VulkanContext;
 // without it opens fp32 and says so in `note`. Throws BackendError.
 std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel>& model, int index,
                                            Precision precision, std::string& note);
-// "vulkan device 0 (NVIDIA H200)", with ", fp16" when it stores fp16.
+// "vulkan device 0 (NVIDIA H200)", with ", fp16" when it stores fp16 and ", tensor cores" (or
+// ", tensor cores emulated") when its products run there (product_kernels.hpp).
 std::string describe(const VulkanContext& context);
 // How many streamed frames a Vulkan backend keeps in flight (its staging ring).
 inline constexpr int kVulkanStreamDepth = 2;

@@ -129,11 +129,24 @@ VulkanDevice::VulkanDevice(VkPhysicalDevice physical, int index)
   VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   VkPhysicalDeviceShaderFloat16Int8Features f16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_FLOAT16_INT8_FEATURES};
   VkPhysicalDevice16BitStorageFeatures storage16{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_16BIT_STORAGE_FEATURES};
+  VkPhysicalDeviceCooperativeMatrixFeaturesNV matrices{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_COOPERATIVE_MATRIX_FEATURES_NV};
+  VkPhysicalDeviceVulkanMemoryModelFeatures memory_model{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_MEMORY_MODEL_FEATURES};
+  const char* const cooperative_matrix = VK_NV_COOPERATIVE_MATRIX_EXTENSION_NAME;
   if (info_.fp16) {  // the fp16 shader variants need both
     f16.shaderFloat16 = VK_TRUE;
     storage16.storageBuffer16BitAccess = VK_TRUE;
     storage16.pNext = &f16;
     info.pNext = &storage16;
+  }
+  if (info_.tensor_cores) {  // the *_coopmat shaders (describe() checked all of it)
+    matrices.cooperativeMatrix = VK_TRUE;
+    memory_model.vulkanMemoryModel = VK_TRUE;
+    memory_model.pNext = &matrices;
+    f16.pNext = &memory_model;
+    info.enabledExtensionCount = 1;
+    info.ppEnabledExtensionNames = &cooperative_matrix;
   }
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
@@ -167,7 +180,16 @@ void VulkanDevice::create_pipelines() {
   layout.pPushConstantRanges = &push;
   check(vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
 
-  for (std::size_t s = 0; s < kShaderCount; ++s) pipelines_[s] = create_pipeline(static_cast<Shader>(s), false);
+  // Those that exist in fp32 on every device now; the rest (fp16, tensor cores) on first use.
+  for (std::size_t s = 0; s < kShaderCount; ++s) {
+    const ShaderInfo& shader = shader_info(static_cast<Shader>(s));
+    if (!shader.spirv.empty() && !shader.tensor_cores) pipelines_[s] = create_pipeline(static_cast<Shader>(s), false);
+  }
+}
+
+bool VulkanDevice::can_run(Shader shader, bool fp16) const {
+  const ShaderInfo& s = shader_info(shader);
+  return (fp16 ? info_.fp16 : !s.spirv.empty()) && (!s.tensor_cores || info_.tensor_cores);
 }
 
 VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16) {
@@ -196,10 +218,16 @@ VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16) {
 
 VkPipeline VulkanDevice::pipeline(Shader shader, bool fp16) {
   const auto s = static_cast<std::size_t>(shader);
-  if (!fp16) return pipelines_[s];
+  if (!can_run(shader, fp16)) {
+    throw BackendError(BackendError::Kind::unavailable, label_ + ": cannot run the shader '" + shader_name(shader) +
+                                                            "' in " + (fp16 ? "fp16" : "fp32") +
+                                                            " (it needs fp16 or tensor cores this device lacks)");
+  }
+  if (!fp16 && pipelines_[s] != VK_NULL_HANDLE) return pipelines_[s];
   const std::lock_guard lock(pipeline_mutex_);
-  if (fp16_pipelines_[s] == VK_NULL_HANDLE) fp16_pipelines_[s] = create_pipeline(shader, true);
-  return fp16_pipelines_[s];
+  VkPipeline& p = fp16 ? fp16_pipelines_[s] : pipelines_[s];
+  if (p == VK_NULL_HANDLE) p = create_pipeline(shader, fp16);
+  return p;
 }
 
 VulkanDevice::~VulkanDevice() { destroy(); }

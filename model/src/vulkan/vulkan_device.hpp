@@ -60,8 +60,11 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   // nanoseconds per tick.
   uint32_t timestamp_bits() const { return timestamp_bits_; }
   double timestamp_period_ns() const { return timestamp_period_ns_; }
-  // The fp16 variants are created on first use (info().fp16 devices only).
+  // The fp16 variants, and the shaders for tensor cores, are created on first use. Throws
+  // BackendError for a shader the device cannot run (can_run()).
   VkPipeline pipeline(Shader shader, bool fp16);
+  // Whether the shader exists in that precision and the device has what it needs.
+  bool can_run(Shader shader, bool fp16) const;
   VkPipelineLayout pipeline_layout() const { return pipeline_layout_; }
   VkDescriptorSetLayout set_layout() const { return set_layout_; }
 

@@ -145,6 +145,59 @@ std::vector<VkPhysicalDevice> physical_devices() {
   return devices;
 }
 
+namespace {
+
+bool has_extension(VkPhysicalDevice device, const char* name) {
+  uint32_t count = 0;
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr);
+  std::vector<VkExtensionProperties> extensions(count);
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &count, extensions.data());
+  for (const auto& e : extensions) {
+    if (std::strcmp(e.extensionName, name) == 0) return true;
+  }
+  return false;
+}
+
+// What the *_coopmat shaders (matmul_fragments.comp with TENSOR_CORES) need: the extension and
+// its feature, the memory model its scopes are written in, a 16×16×16 fp16 × fp16 + fp32 shape
+// at subgroup scope, and subgroups of 32 (a workgroup of 128 is 4 of them, 2×2 fragments each).
+bool has_tensor_cores(VkPhysicalDevice device, bool vulkan12) {
+  if (!vulkan12 || !has_extension(device, VK_NV_COOPERATIVE_MATRIX_EXTENSION_NAME) ||
+      vkGetPhysicalDeviceCooperativeMatrixPropertiesNV == nullptr) {
+    return false;
+  }
+  VkPhysicalDeviceCooperativeMatrixFeaturesNV matrices{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_COOPERATIVE_MATRIX_FEATURES_NV};
+  VkPhysicalDeviceVulkanMemoryModelFeatures memory_model{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_MEMORY_MODEL_FEATURES};
+  memory_model.pNext = &matrices;
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  features.pNext = &memory_model;
+  vkGetPhysicalDeviceFeatures2(device, &features);
+  if (!matrices.cooperativeMatrix || !memory_model.vulkanMemoryModel) return false;
+
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(device, &props);
+  if (subgroup.subgroupSize != 32) return false;
+
+  uint32_t count = 0;
+  if (vkGetPhysicalDeviceCooperativeMatrixPropertiesNV(device, &count, nullptr) != VK_SUCCESS) return false;
+  std::vector<VkCooperativeMatrixPropertiesNV> shapes(count, {VK_STRUCTURE_TYPE_COOPERATIVE_MATRIX_PROPERTIES_NV});
+  if (vkGetPhysicalDeviceCooperativeMatrixPropertiesNV(device, &count, shapes.data()) != VK_SUCCESS) return false;
+  for (const auto& s : shapes) {
+    if (s.MSize == 16 && s.NSize == 16 && s.KSize == 16 && s.AType == VK_COMPONENT_TYPE_FLOAT16_NV &&
+        s.BType == VK_COMPONENT_TYPE_FLOAT16_NV && s.CType == VK_COMPONENT_TYPE_FLOAT32_NV &&
+        s.DType == VK_COMPONENT_TYPE_FLOAT32_NV && s.scope == VK_SCOPE_SUBGROUP_NV) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 GpuDevice describe(VkPhysicalDevice device, int index) {
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(device, &props);
@@ -176,6 +229,7 @@ GpuDevice describe(VkPhysicalDevice device, int index) {
   }
   d.max_buffer_bytes = props.limits.maxStorageBufferRange;
   d.fp16 = vulkan12 && f16.shaderFloat16 && storage16.storageBuffer16BitAccess;
+  d.tensor_cores = d.fp16 && has_tensor_cores(device, vulkan12);
   // The queue family VulkanDevice takes: the first with compute.
   uint32_t families = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(device, &families, nullptr);

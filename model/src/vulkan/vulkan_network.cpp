@@ -12,14 +12,19 @@
 
 namespace neuflow::model::vulkan {
 
-VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width)
+VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width,
+                             ProductKernels products)
     : weights_(std::move(weights)),
       device_(*weights_->device),
       fp16_(weights_->fp16),
+      products_(products),
       elem_(fp16_ ? 2 : 4),
       height_(height),
       width_(width),
       tokens_((height / 16) * (width / 16)) {
+  if (products_ != ProductKernels::scalar && !fp16_) {
+    throw std::logic_error("VulkanNetwork: the tensor-core products take fp16 tensors");
+  }
   block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
   graph_ = graph::build_network_graph<DeviceTensor>(*weights_, height, width, kPlanIterations, block_rows_);
   graph::check_shapes(graph_);

@@ -31,6 +31,7 @@
 #include "neuflow/model/stage_observer.hpp"
 #include "tensor.hpp"
 #include "vulkan/device_weights.hpp"
+#include "vulkan/product_kernels.hpp"
 
 namespace neuflow::model::vulkan {
 
@@ -48,8 +49,10 @@ class VulkanNetwork {
  public:
   static constexpr int kSlots = InferenceBackend::kSlots;  // frame features kept on the device
 
-  // height, width: multiples of 16, at least 32. Throws BackendError (e.g. out of memory).
-  VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width);
+  // height, width: multiples of 16, at least 32. products: the kernels its products run on
+  // (product_kernels_for()). Throws BackendError (e.g. out of memory).
+  VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width,
+                ProductKernels products = ProductKernels::scalar);
   ~VulkanNetwork();
   VulkanNetwork(const VulkanNetwork&) = delete;
   VulkanNetwork& operator=(const VulkanNetwork&) = delete;
@@ -147,7 +150,8 @@ class VulkanNetwork {
 
   std::shared_ptr<const DeviceWeights> weights_;
   VulkanDevice& device_;
-  bool fp16_;         // tensors stored as float16_t
+  bool fp16_;  // tensors stored as float16_t
+  ProductKernels products_;
   std::size_t elem_;  // bytes per stored value: 4 or 2
   int height_, width_, tokens_, block_rows_;
 

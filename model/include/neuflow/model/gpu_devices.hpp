@@ -33,7 +33,10 @@ struct GpuDevice {
   std::uint64_t memory_bytes = 0;      // device-local heaps
   std::uint64_t max_buffer_bytes = 0;  // maxStorageBufferRange
   bool fp16 = false;                   // shaderFloat16 and 16-bit storage
-  bool timestamps = false;             // its compute queue has timestamps: FlowSession::device_stage_times()
+  // VK_NV_cooperative_matrix with 16×16×16 fp16 × fp16 + fp32 products in subgroups of 32 (and
+  // the Vulkan memory model): fp16 sessions run their products on tensor cores.
+  bool tensor_cores = false;
+  bool timestamps = false;  // its compute queue has timestamps: FlowSession::device_stage_times()
   bool is_gpu() const { return type == "discrete" || type == "integrated"; }
 };
 

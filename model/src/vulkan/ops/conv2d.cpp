@@ -20,7 +20,7 @@ void record_winograd(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const V
                                      {r.bytes(in.count()), fp32(points), 0},
                                      groups(static_cast<long>(in.c) * tile_count, kLocal));
   const long long filters = 36LL * out.c * in.c;
-  r.dispatch<Shader::winograd_gemm>(
+  r.product<Shader::winograd_gemm>(
       {&r.device_weights().winograd_buffer, &r.winograd_points(), &r.winograd_products(), nullptr},
       WinogradGemmParams{out.c, tile_count, in.c, r.device_weights().winograd_filters_of(w)},
       {r.bytes(filters) + fp32(points), fp32(products), filters * tile_count}, tiles(tile_count, "a convolution"),
@@ -71,9 +71,9 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
                        1.f};
   const long long taps = static_cast<long long>(in.c) * w.kernel_h * w.kernel_w;
   const long long read = in.count() + taps * out.c + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
-  r.dispatch<Shader::conv2d>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
-                             {r.bytes(read), r.bytes(out.count()), taps * out.count()},
-                             tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
+  r.product<Shader::conv2d>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
+                            {r.bytes(read), r.bytes(out.count()), taps * out.count()},
+                            tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
 }
 
 }  // namespace neuflow::model::vulkan

@@ -24,9 +24,9 @@ void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op) {
                        1.f};
   const long long weights = static_cast<long long>(w.out_features) * w.in_features;
   const long long read = weights + (w.bias.offset >= 0 ? w.out_features : 0) + in.count();
-  r.dispatch<Shader::matmul>({&r.weights(), in.buffer, out.buffer, nullptr}, p,
-                             {r.bytes(read), r.bytes(out.count()), weights * tokens}, tiles(tokens, "attention"),
-                             tiles(w.out_features, "attention"));
+  r.product<Shader::matmul>({&r.weights(), in.buffer, out.buffer, nullptr}, p,
+                            {r.bytes(read), r.bytes(out.count()), weights * tokens}, tiles(tokens, "attention"),
+                            tiles(w.out_features, "attention"));
 }
 
 }  // namespace neuflow::model::vulkan

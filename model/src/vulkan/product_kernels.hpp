@@ -1,0 +1,67 @@
+#pragma once
+// Which kernels the Vulkan backend's products (the implicit-GEMM convolutions, the Winograd
+// products and the matrix products) run on:
+//  - scalar: matmul.comp, fp32 arithmetic, every device and precision;
+//  - tensor_cores: matmul_fragments.comp on VK_NV_cooperative_matrix, fp16 operands and fp32
+//    sums, where the device has them and the session stores fp16 (the default there);
+//  - twin: the same tiles with the fragment products written out, which any fp16 device
+//    runs: how lavapipe tests the tensor-core path's tiling and numbers.
+// NEUFLOW_VULKAN_PRODUCTS=auto|scalar|tensor-cores|twin chooses (auto, the default: tensor
+// cores where they run, else scalar).
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+
+#include "neuflow/model/gpu_devices.hpp"
+#include "vulkan/shaders.hpp"
+
+namespace neuflow::model::vulkan {
+
+enum class ProductKernels { scalar, tensor_cores, twin };
+
+inline const char* product_kernels_name(ProductKernels k) {
+  switch (k) {
+    case ProductKernels::scalar: return "scalar";
+    case ProductKernels::tensor_cores: return "tensor-cores";
+    case ProductKernels::twin: return "twin";
+  }
+  return "scalar";
+}
+
+// Throws std::invalid_argument for a value it does not know, and BackendError (unavailable)
+// where the device or the precision cannot run what the variable asks for.
+inline ProductKernels product_kernels_for(const GpuDevice& device, bool fp16) {
+  const char* v = std::getenv("NEUFLOW_VULKAN_PRODUCTS");
+  const std::string want = v == nullptr || *v == '\0' ? "auto" : v;
+  if (want == "auto") return fp16 && device.tensor_cores ? ProductKernels::tensor_cores : ProductKernels::scalar;
+  if (want == "scalar") return ProductKernels::scalar;
+  if (want != "tensor-cores" && want != "twin") {
+    throw std::invalid_argument("NEUFLOW_VULKAN_PRODUCTS: expected auto, scalar, tensor-cores or twin, got \"" + want +
+                                "\"");
+  }
+  if (!fp16) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       "NEUFLOW_VULKAN_PRODUCTS=" + want + " multiplies fp16 operands: it needs precision fp16");
+  }
+  if (want == "tensor-cores" && !device.tensor_cores) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       "NEUFLOW_VULKAN_PRODUCTS=tensor-cores: " + device.name +
+                           " has no VK_NV_cooperative_matrix with 16×16×16 fp16 products in subgroups of 32 "
+                           "(`neuflow devices` says which devices have tensor cores)");
+  }
+  return want == "twin" ? ProductKernels::twin : ProductKernels::tensor_cores;
+}
+
+// The shader that computes the product `scalar` (conv2d, matmul or winograd_gemm) with `kernels`.
+inline Shader product_shader(Shader scalar, ProductKernels kernels) {
+  if (kernels == ProductKernels::scalar) return scalar;
+  const bool cores = kernels == ProductKernels::tensor_cores;
+  switch (scalar) {
+    case Shader::conv2d: return cores ? Shader::conv2d_coopmat : Shader::conv2d_coopmat_twin;
+    case Shader::matmul: return cores ? Shader::matmul_coopmat : Shader::matmul_coopmat_twin;
+    case Shader::winograd_gemm: return cores ? Shader::winograd_gemm_coopmat : Shader::winograd_gemm_coopmat_twin;
+    default: throw std::logic_error(std::string("product_shader: ") + shader_name(scalar) + " is not a product");
+  }
+}
+
+}  // namespace neuflow::model::vulkan

@@ -1,0 +1,95 @@
+// What the three kinds of product read and where they write, shared by the scalar tiles
+// (matmul.comp) and the fragment tiles of the tensor-core path (matmul_fragments.comp), so the
+// two cannot disagree on an operand:
+//  - IMPLICIT_CONV: A is a convolution's OIHW weights read as a row-major [Cout][Cin·k·k]
+//    matrix and B the im2col of a planar [C][H][W] input, gathered on the fly (never stored);
+//    C is the planar output. Bias and activation fused; `addend` (same shape as C) is added
+//    before the activation.
+//  - WINOGRAD_GEMM: the 36 products of F(4×4, 3×3), one per workgroup z: the transformed
+//    filters [36][Cout][Cin] (binding 0) by the transformed input tiles [36][Cin][tiles] into
+//    [36][Cout][tiles]; the tiles and products are fp32 in either precision.
+//  - otherwise a general strided product (attention, matching): every operand has a row and a
+//    column stride, so transposes are free.
+// Needs the bindings (a_data, b_data, c_data, d_data) and the push constants p declared.
+
+#include "activate.glsl"
+
+#ifdef IMPLICIT_CONV
+int gemm_m() { return p.out_c; }
+int gemm_n() { return p.out_h * p.out_w; }
+int gemm_k() { return p.in_c * p.kernel * p.kernel; }
+#else
+int gemm_m() { return p.m; }
+int gemm_n() { return p.n; }
+int gemm_k() { return p.k; }
+#endif
+
+// A column of B as one invocation gathers it through the whole K loop: where a convolution's
+// window starts is worked out once, not per element.
+struct GemmColumn {
+  int n;
+  bool ok;
+  int iy0, ix0;
+};
+
+GemmColumn gemm_column(int n) {
+  GemmColumn c;
+  c.n = n;
+  c.ok = n < gemm_n();
+#ifdef IMPLICIT_CONV
+  const int oy = n / p.out_w, ox = n - (n / p.out_w) * p.out_w;
+  c.iy0 = oy * p.stride - p.pad;
+  c.ix0 = ox * p.stride - p.pad;
+#else
+  c.iy0 = 0;
+  c.ix0 = 0;
+#endif
+  return c;
+}
+
+// A[m][k], 0 outside the matrix.
+float gemm_a(int m, int k) {
+  if (m >= gemm_m() || k >= gemm_k()) return 0.0;
+#if defined(IMPLICIT_CONV)
+  return float(a_data[p.w_off + m * gemm_k() + k]);
+#elif defined(WINOGRAD_GEMM)
+  return float(a_data[p.w_off + (int(gl_WorkGroupID.z) * gemm_m() + m) * gemm_k() + k]);
+#else
+  return float(a_data[p.a_off + m * p.a_rs + k * p.a_cs]);
+#endif
+}
+
+// B[k][column], 0 outside the matrix (and in a convolution's padding).
+float gemm_b(GemmColumn c, int k) {
+  if (!c.ok || k >= gemm_k()) return 0.0;
+#if defined(IMPLICIT_CONV)
+  const int kk2 = p.kernel * p.kernel;
+  const int ci = k / kk2, rem = k - ci * kk2;
+  const int ky = rem / p.kernel, kx = rem - ky * p.kernel;
+  const int iy = c.iy0 + ky, ix = c.ix0 + kx;
+  if (iy < 0 || iy >= p.in_h || ix < 0 || ix >= p.in_w) return 0.0;
+  return float(b_data[p.in_off + ci * p.in_h * p.in_w + iy * p.in_w + ix]);
+#elif defined(WINOGRAD_GEMM)
+  return b_data[(int(gl_WorkGroupID.z) * gemm_k() + k) * gemm_n() + c.n];
+#else
+  return float(b_data[p.b_off + k * p.b_rs + c.n * p.b_cs]);
+#endif
+}
+
+// Writes C[m][n] from its sum of products, with what the product fuses (scale, bias, addend,
+// activation); nothing outside the matrix.
+void gemm_store(int m, int n, float sum) {
+  if (m >= gemm_m() || n >= gemm_n()) return;
+#if defined(IMPLICIT_CONV)
+  float v = p.alpha * sum;
+  if (p.bias_off >= 0) v += float(a_data[p.bias_off + m]);
+  if (p.add_off >= 0) v += float(d_data[p.add_off + m * gemm_n() + n]);
+  c_data[p.out_off + m * gemm_n() + n] = VALUE(activate(v, p.act));
+#elif defined(WINOGRAD_GEMM)
+  c_data[(int(gl_WorkGroupID.z) * gemm_m() + m) * gemm_n() + n] = sum;
+#else
+  float v = p.alpha * sum;
+  if (p.bias_off >= 0) v += float(a_data[p.bias_off + m]);
+  c_data[p.c_off + m * p.c_rs + n * p.c_cs] = VALUE(activate(v, p.act));
+#endif
+}

@@ -1,0 +1,136 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// The products of gemm_operands.glsl on tensor cores: fp16 operands, fp32 sums. Each
+// workgroup of 4 subgroups of 32 computes a 64×64 tile of C; each subgroup a 32×32 quarter of
+// it as 2×2 fragments of 16×16, over K in steps of 32 (two fragment steps of 16) staged as
+// fp16 through workgroup memory.
+//  - TENSOR_CORES: the fragments are VK_NV_cooperative_matrix matrices (16×16×16,
+//    fp16 × fp16 + fp32), taken where the device has them (GpuDevice::tensor_cores).
+//  - otherwise the emulated twin, which any fp16 device (lavapipe included) runs: the same
+//    tiles, the same fp16 operands in the same workgroup memory, the same staging of the sums
+//    and the same epilogue; only the 16×16×16 product is written out, each of a subgroup's 32
+//    invocations summing 8 of a fragment's 256 outputs in fp32. The tests check the twin
+//    against the CPU at every product the network has, and the GPU check the real thing
+//    against the twin.
+#ifdef TENSOR_CORES
+#extension GL_NV_cooperative_matrix : require
+#extension GL_KHR_memory_scope_semantics : require
+#extension GL_KHR_shader_subgroup_basic : require
+#endif
+#include "precision.glsl"
+layout(local_size_x = 128) in;
+
+layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
+#ifdef WINOGRAD_GEMM
+layout(std430, binding = 1) readonly buffer BufB { float b_data[]; };
+layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };
+#else
+layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
+layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
+#endif
+layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend
+
+#ifdef IMPLICIT_CONV
+#include "params/conv2d_params.h"
+#elif defined(WINOGRAD_GEMM)
+#include "params/winograd_gemm_params.h"
+#else
+#include "params/matmul_params.h"
+#endif
+
+#include "gemm_operands.glsl"
+
+const int BM = 64, BN = 64, BK = 32;  // the workgroup's tile and K step
+const int F = 16;                     // a fragment: 16×16, K 16
+// Row strides in workgroup memory, padded by 16 bytes: a fragment load's rows start on 16-byte
+// boundaries (as cooperative-matrix loads need) in different banks.
+const int SA = BK + 8, SB = BN + 8, SC = F + 4;
+shared float16_t tile_a[BM * SA];  // [m][k]
+shared float16_t tile_b[BK * SB];  // [k][n]
+shared float sums[4 * F * SC];     // one fragment's sums per subgroup, on their way out
+
+#ifdef TENSOR_CORES
+#define OPERAND fcoopmatNV<16, gl_ScopeSubgroup, F, F>
+#define SUMS fcoopmatNV<32, gl_ScopeSubgroup, F, F>
+#endif
+
+void main() {
+  const int tid = int(gl_LocalInvocationIndex);
+  const int lane = tid % 32;
+  const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
+  const int col0 = int(gl_WorkGroupID.x) * BN;  // columns of C (output pixels)
+  const int K = gemm_k();
+  // B is gathered by column, each invocation the same column through the K loop.
+  const GemmColumn column = gemm_column(col0 + tid % BN);
+#ifdef TENSOR_CORES
+  const int warp = int(gl_SubgroupID);
+#else
+  const int warp = tid / 32;
+#endif
+  const int warp_row = (warp / 2) * 32, warp_col = (warp % 2) * 32;  // its quarter of the tile
+
+#ifdef TENSOR_CORES
+  SUMS acc[2][2];
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) acc[i][j] = SUMS(0.0);
+#else
+  // Invocation `lane` holds rows lane / 16 + 2q, column lane % 16 of each fragment.
+  float acc[2][2][8];
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int q = 0; q < 8; ++q) acc[i][j][q] = 0.0;
+#endif
+
+  for (int k0 = 0; k0 < K; k0 += BK) {
+    // A: 64 rows × 32 k, adjacent invocations read adjacent k (row-major weights).
+    for (int r = 0; r < 16; ++r) {
+      const int e = tid + 128 * r;
+      const int kk = e % BK, mm = e / BK;
+      tile_a[mm * SA + kk] = float16_t(gemm_a(row0 + mm, k0 + kk));
+    }
+    // B: 32 k × 64 columns, adjacent invocations read adjacent columns.
+    for (int r = 0; r < 16; ++r) {
+      const int kk = tid / BN + 2 * r;
+      tile_b[kk * SB + tid % BN] = float16_t(gemm_b(column, k0 + kk));
+    }
+    barrier();
+    for (int kf = 0; kf < BK; kf += F) {
+#ifdef TENSOR_CORES
+      OPERAND a[2], b[2];
+      for (int i = 0; i < 2; ++i) coopMatLoadNV(a[i], tile_a, (warp_row + F * i) * SA + kf, SA, false);
+      for (int j = 0; j < 2; ++j) coopMatLoadNV(b[j], tile_b, kf * SB + warp_col + F * j, SB, false);
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j) acc[i][j] = coopMatMulAddNV(a[i], b[j], acc[i][j]);
+#else
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+          for (int q = 0; q < 8; ++q) {
+            const int a_row = (warp_row + F * i + lane / 16 + 2 * q) * SA + kf;
+            const int b_col = kf * SB + warp_col + F * j + lane % 16;
+            float s = acc[i][j][q];
+            for (int t = 0; t < F; ++t) s = fma(float(tile_a[a_row + t]), float(tile_b[b_col + t * SB]), s);
+            acc[i][j][q] = s;
+          }
+#endif
+    }
+    barrier();
+  }
+
+  // The sums leave a fragment at a time through workgroup memory, so that the epilogue knows
+  // where each is (a cooperative matrix's layout across invocations is the driver's).
+  const int out_row = ((tid / 32) / 2) * 32, out_col = ((tid / 32) % 2) * 32;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) {
+#ifdef TENSOR_CORES
+      coopMatStoreNV(acc[i][j], sums, warp * F * SC, SC, false);
+#else
+      for (int q = 0; q < 8; ++q) sums[warp * F * SC + (lane / 16 + 2 * q) * SC + lane % 16] = acc[i][j][q];
+#endif
+      barrier();
+      for (int q = 0; q < 8; ++q) {
+        const int r = lane / 16 + 2 * q, c = lane % 16;
+        gemm_store(row0 + out_row + F * i + r, col0 + out_col + F * j + c, sums[(tid / 32) * F * SC + r * SC + c]);
+      }
+      barrier();
+    }
+}
