@@ -144,6 +144,10 @@ lavapipe_repeats+='|VulkanSession\.DirectConvolutionsGiveTheCpusFlowToo'
 lavapipe_repeats+='|VulkanWork\.(WinogradComputesFewerMultiplyAdds|APipelinedFrameTakesOneSubmissionAndOneWait'
 lavapipe_repeats+='|Fp16HalvesTheTensorsBytes|AnObservedPassIsNotCounted)'
 lavapipe_repeats+='|plugin\.vulkan_pipeline_matches_cli'
+# The tensor-core twin's network runs (its routing is the host code the Debian run checks) and
+# the GPU check's lavapipe run; the error test for impossible choices stays.
+lavapipe_repeats+='|VulkanTensorCores\.(TheTwinRunsEveryProductOfTheNetwork|TheTwinStaysWithinTheFp16BoundOfFp32)'
+lavapipe_repeats+='|gpu_check_runs_on_any_vulkan_device'
 # Not understood yet (2026-12-06): at neuflowd's exit after this test, LeakSanitizer's tracer
 # (GCC 11's runtime here) dies of signal 11 and the process exits -6, every time; the test passes
 # in the release build and under Debian 12's ASan (4 of 4). Left out here until that is found.

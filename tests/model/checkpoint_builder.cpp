@@ -2,10 +2,15 @@
 
 #include <zip.h>
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <memory>
+#include <random>
 #include <stdexcept>
 
 #include "neuflow/model/architecture.hpp"
@@ -270,6 +275,48 @@ FakeCheckpoint fake_neuflow_checkpoint() {
       t.storage_key = "0";
       t.storage_numel = largest;
     }
+    ckpt.tensors.push_back(std::move(t));
+  }
+  return ckpt;
+}
+
+FakeCheckpoint random_neuflow_checkpoint(std::uint32_t seed) {
+  const auto& specs = model::neuflow_v2_parameters();
+  // A weight's fan-in, by its layer's name, for the layer's bias too.
+  std::map<std::string, int64_t> fan_in;
+  for (const auto& spec : specs) {
+    if (spec.name.ends_with(".weight") && spec.shape.size() >= 2) {
+      int64_t fan = 1;
+      for (std::size_t d = 1; d < spec.shape.size(); ++d) fan *= spec.shape[d];
+      fan_in[spec.name.substr(0, spec.name.size() - 7)] = fan;
+    }
+  }
+  std::mt19937 random(seed);
+  FakeCheckpoint ckpt;
+  for (const auto& spec : specs) {
+    FakeTensor t;
+    t.name = spec.name;
+    t.size = spec.shape;
+    t.storage_key = std::to_string(ckpt.storages.size());
+    t.storage_numel = spec.numel();
+    if (spec.kind == model::ParameterKind::kBatchCounter) {
+      t.storage_type = "LongStorage";
+      ckpt.storages.emplace_back(t.storage_key, le_i64({0}));
+      ckpt.tensors.push_back(std::move(t));
+      continue;
+    }
+    const std::string layer = spec.name.substr(0, spec.name.rfind('.'));
+    const auto fan = fan_in.find(layer);
+    std::vector<float> values(static_cast<std::size_t>(spec.numel()));
+    if (fan != fan_in.end()) {  // a convolution's or linear layer's weight or bias
+      const float bound = 1.f / std::sqrt(static_cast<float>(fan->second));
+      std::uniform_real_distribution<float> uniform(-bound, bound);
+      for (float& v : values) v = uniform(random);
+    } else {  // a norm's scale and running variance 1, its shift and running mean 0
+      const bool one = spec.name.ends_with(".weight") || spec.name.ends_with(".running_var");
+      std::fill(values.begin(), values.end(), one ? 1.f : 0.f);
+    }
+    ckpt.storages.emplace_back(t.storage_key, le_floats(values));
     ckpt.tensors.push_back(std::move(t));
   }
   return ckpt;

@@ -104,6 +104,12 @@ struct FakeCheckpoint {
 // shared float storage (and one int64 storage for the counters), so the file stays small.
 FakeCheckpoint fake_neuflow_checkpoint();
 
+// NeuFlow-V2 with random weights as a freshly made PyTorch model has them (what the fixture
+// checkpoint holds): convolution and linear weights and biases uniform in ±1/√fan-in, norms'
+// scales 1 and shifts 0, BatchNorm's running mean 0 and variance 1. For checks that need a
+// whole network where the fixtures are not (neuflow-gpu-check on a GPU machine).
+FakeCheckpoint random_neuflow_checkpoint(std::uint32_t seed);
+
 std::string read_file(const std::filesystem::path& path);
 void write_file(const std::filesystem::path& path, std::string_view bytes);
 
