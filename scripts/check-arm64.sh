@@ -43,7 +43,7 @@ arm64_packages=(
   libdnnl-dev
   libvulkan-dev libvulkan-volk-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-video-dev
-  libzip-dev libpng-dev libcli11-dev
+  libzip-dev libpng-dev libjpeg-dev libcli11-dev
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev libgstrtspserver-1.0-dev
   gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good
   gstreamer1.0-plugins-bad gstreamer1.0-plugins-ugly gstreamer1.0-libav   # h264parse, x264enc, decoders

@@ -13,6 +13,7 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-imgcodecs-dev libopencv-video-dev
   libzip-dev                        # the zip container of PyTorch checkpoints
   libpng-dev                        # flow/: KITTI flow PNGs and renderings
+  libjpeg-dev                       # the neuflow command: a JPEG's size read from its header before decoding
   libcli11-dev                      # command-line parsing
   libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev   # the GStreamer plugin
   gstreamer1.0-plugins-base gstreamer1.0-plugins-good gstreamer1.0-tools

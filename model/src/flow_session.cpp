@@ -90,6 +90,15 @@ std::optional<std::string> FlowSession::memory_problem(int frame_width, int fram
   return model::memory_problem(*state_->weights, options_, g.model_height, g.model_width);
 }
 
+std::optional<std::string> FlowSession::frame_problem(int frame_width, int frame_height) const {
+  try {
+    plan_geometry(frame_width, frame_height, options_);
+  } catch (const std::invalid_argument& e) {
+    return std::string(e.what());
+  }
+  return memory_problem(frame_width, frame_height);
+}
+
 const std::string& FlowSession::backend_description() const { return state_->backends->description(); }
 const std::string& FlowSession::fallback_warning() const { return state_->backends->fallback(); }
 const std::vector<StageTime>& FlowSession::device_stage_times() const { return state_->stage_times; }

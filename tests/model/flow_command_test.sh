@@ -74,6 +74,30 @@ grep -q "model-width: expected a multiple of 16" "$out/err" || fail "unclear mod
 [ $? -ne 0 ] || fail "a plan over --max-memory ran"
 grep -q "a 320x256 model size needs about .*, more than the 1 MiB max-memory allows" "$out/err" \
   || fail "unclear max-memory error: $(cat "$out/err")"
+# An image is refused by the size its header states, before it is decoded: a 3 KB PNG that
+# says 20000x20000 (1.2 GB decoded) is past the supported range, and one that says 4000x3000 is
+# past a small --max-memory; neither takes the memory its decoding would.
+"$python" - "$out" "$neuflow" "$fixture/checkpoint.pth" <<'PY' || fail "a PNG's header size was not refused before decoding"
+import resource, struct, subprocess, sys, zlib
+out, neuflow, checkpoint = sys.argv[1:4]
+def png(path, width, height):  # a valid header and a few rows of data, no more
+    chunk = lambda t, d: struct.pack('>I', len(d)) + t + d + struct.pack('>I', zlib.crc32(t + d))
+    rows = zlib.compress((b'\0' + b'\0' * width * 3) * 8, 9)
+    with open(path, 'wb') as f:
+        f.write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', width, height, 8, 2, 0, 0, 0))
+                + chunk(b'IDAT', rows) + chunk(b'IEND', b''))
+png(f'{out}/huge.png', 20000, 20000)
+png(f'{out}/large.png', 4000, 3000)
+for image, options, says in [('huge.png', [], 'outside the supported range'),
+                             ('large.png', ['--max-memory', '64'], 'more than the 64 MiB max-memory allows')]:
+    r = subprocess.run([neuflow, 'flow', '-m', checkpoint, *options, f'{out}/{image}', f'{out}/{image}',
+                        f'{out}/x.flo'], capture_output=True, text=True)
+    assert r.returncode == 65, (image, r.returncode, r.stderr)
+    assert 'its header says' in r.stderr and 'not decoded' in r.stderr and says in r.stderr, r.stderr
+rss_mb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+print(f'largest resident size of the refused runs: {rss_mb:.0f} MB')
+assert rss_mb < 500, rss_mb
+PY
 
 # Without --model: $NEUFLOW_MODEL, else models/neuflow_mixed.pth in the working folder, each said
 # on stderr; with neither, a usage error naming all three.

@@ -11,8 +11,8 @@
 // Then one table: per size, precision and product kernels, a streamed frame's time (pipelined,
 // frames in flight), a pair's, the GPU's own time of a frame (its timestamps), and what a frame
 // asks of it (dispatches, barriers, GB moved, GMAC).
-#include <CLI/CLI.hpp>
 #include <stdlib.h>  // mkdtemp, setenv
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -45,7 +45,8 @@ std::vector<std::uint8_t> draw_frame(const Size& s, int index, double dx = 3.25,
     for (int x = 0; x < s.w; ++x) {
       const double u = x - dx * index, v = y - dy * index;
       for (int c = 0; c < 3; ++c) {
-        const double value = 128 + 50 * std::sin(0.031 * u + 0.017 * v + c) + 30 * std::cos(0.007 * u - 0.023 * v * (c + 1)) +
+        const double value = 128 + 50 * std::sin(0.031 * u + 0.017 * v + c) +
+                             30 * std::cos(0.007 * u - 0.023 * v * (c + 1)) +
                              20 * std::sin(0.41 * u) * std::cos(0.37 * v + c);
         bgr[(static_cast<std::size_t>(y) * s.w + x) * 3 + c] = static_cast<std::uint8_t>(std::clamp(value, 0.0, 255.0));
       }
@@ -68,8 +69,8 @@ class Products {
 };
 
 struct Difference {
-  double max = 0, mean = 0;        // per component, px
-  double epe = 0, worst = 0;       // end-point error, mean and largest
+  double max = 0, mean = 0;           // per component, px
+  double epe = 0, worst = 0;          // end-point error, mean and largest
   double magnitude = 0, largest = 0;  // of the reference
 };
 
@@ -108,8 +109,10 @@ void check_exact(const std::string& what, const Difference& d) {
 
 void check_fp16(const std::string& what, const Difference& d) {
   char text[200];
-  std::snprintf(text, sizeof text, "mean EPE %.3f %% of the mean |flow| (%.2f px), max %.3f %% of the largest (%.2f px); bounds 0.5 %%, 1 %%",
-                100 * d.epe / d.magnitude, d.magnitude, 100 * d.worst / d.largest, d.largest);
+  std::snprintf(
+      text, sizeof text,
+      "mean EPE %.3f %% of the mean |flow| (%.2f px), max %.3f %% of the largest (%.2f px); bounds 0.5 %%, 1 %%",
+      100 * d.epe / d.magnitude, d.magnitude, 100 * d.worst / d.largest, d.largest);
   report(what, d.epe < 0.005 * d.magnitude && d.worst < 0.01 * d.largest, text);
 }
 
@@ -177,8 +180,9 @@ void time_row(const std::shared_ptr<const FlowModel>& model, int device, const S
   }
   std::sort(pairs.begin(), pairs.end());
   std::printf("| %4dx%-4d | %-4s | %-12s | %8.2f | %8.2f | %8.2f | %2d | %5d | %5d | %6.3f | %7.2f |\n", s.w, s.h,
-              precision == Precision::fp16 ? "fp16" : "fp32", products, stream_ms, pairs[pairs.size() / 2], device_ms, depth,
-              work.dispatches, work.barriers, static_cast<double>(work.bytes_read() + work.bytes_written()) / 1e9,
+              precision == Precision::fp16 ? "fp16" : "fp32", products, stream_ms, pairs[pairs.size() / 2], device_ms,
+              depth, work.dispatches, work.barriers,
+              static_cast<double>(work.bytes_read() + work.bytes_written()) / 1e9,
               static_cast<double>(work.multiply_adds()) / 1e9);
 }
 
@@ -230,7 +234,8 @@ int run(int argc, char** argv) {
     return missing;
   }
   const GpuDevice& gpu = devices[static_cast<std::size_t>(device)];
-  if (!gpu.is_gpu()) std::printf("note: device %d is not a GPU (%s): its times say nothing of a GPU's\n", device, gpu.type.c_str());
+  if (!gpu.is_gpu())
+    std::printf("note: device %d is not a GPU (%s): its times say nothing of a GPU's\n", device, gpu.type.c_str());
 
   char folder_template[] = "/tmp/neuflow-gpu-check-XXXXXX";
   if (mkdtemp(folder_template) == nullptr) {
@@ -249,7 +254,9 @@ int run(int argc, char** argv) {
   }
   check_parity(model, device, gpu, *checked);
 
-  std::printf("\n| size | prec | products | stream ms/frame | pair ms | GPU ms/frame | in flight | dispatches | barriers | GB moved | GMAC |\n");
+  std::printf(
+      "\n| size | prec | products | stream ms/frame | pair ms | GPU ms/frame | in flight | dispatches | barriers | GB "
+      "moved | GMAC |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& text : sizes) {
     const auto s = parse_size(text);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "common/image_header.hpp"
 #include "common/model_path.hpp"
 #include "common/session_options.hpp"
 #include "neuflow/flow/errors.hpp"
@@ -27,8 +28,15 @@ struct FlowArgs {
   double max_flow = 0;
 };
 
-cv::Mat read_image(const std::string& path) {
+void require_image_file(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw CommandError(kExitNoInput, path + ": no such image file");
+}
+
+// Refused by the size its header states where the session could not take frames that large,
+// before decoding (which would take the memory first).
+cv::Mat read_image(const std::string& path, const model::FlowSession& session) {
+  const auto check = [&](int w, int h) { return session.frame_problem(w, h); };
+  if (auto problem = image_too_large(path, check)) throw CommandError(kExitDataError, *problem);
   cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
   if (img.empty()) throw CommandError(kExitDataError, path + ": not an image OpenCV can decode");
   return img;
@@ -48,13 +56,15 @@ void run_flow(const FlowArgs& a) {
   }
   const model::SessionOptions options = session_options(a.session);
   const std::string model_path = resolve_model(a.model, "flow");  // a usage error before any file is read
-  const cv::Mat img0 = read_image(a.image0), img1 = read_image(a.image1);
-  if (img0.size() != img1.size()) {
-    throw CommandError(kExitDataError, a.image0 + " and " + a.image1 + " differ in size");
-  }
+  require_image_file(a.image0);
+  require_image_file(a.image1);
   const auto model = load_model(model_path);
   model::FlowSession session(model, options);
   std::string announced = announce_backend(session, "flow");
+  const cv::Mat img0 = read_image(a.image0, session), img1 = read_image(a.image1, session);
+  if (img0.size() != img1.size()) {
+    throw CommandError(kExitDataError, a.image0 + " and " + a.image1 + " differ in size");
+  }
   const auto view = [](const cv::Mat& m) {  // OpenCV decodes to BGR
     return model::ImageView{m.data, m.cols, m.rows, static_cast<std::ptrdiff_t>(m.step[0]), model::ChannelOrder::bgr};
   };

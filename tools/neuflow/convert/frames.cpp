@@ -30,7 +30,8 @@ struct ImageFile {
 
 class ImageSequence final : public FrameSource {
  public:
-  explicit ImageSequence(std::vector<ImageFile> files) : files_(std::move(files)), times_(capture_times_ns(stems())) {}
+  ImageSequence(std::vector<ImageFile> files, FrameSizeCheck check)
+      : files_(std::move(files)), times_(capture_times_ns(stems())), check_(std::move(check)) {}
 
   std::optional<Frame> next() override {
     if (next_ >= files_.size()) return std::nullopt;
@@ -38,6 +39,9 @@ class ImageSequence final : public FrameSource {
     std::error_code ec;
     if (!fs::is_regular_file(file.path, ec))
       throw InputError(kExitNoInput, file.path.string() + ": no such image file");
+    if (check_) {
+      if (auto problem = image_too_large(file.path, check_)) throw InputError(kExitDataError, *problem);
+    }
     Frame frame;
     frame.pixels = cv::imread(file.path.string(), cv::IMREAD_COLOR);
     if (frame.pixels.empty()) {
@@ -65,6 +69,7 @@ class ImageSequence final : public FrameSource {
 
   std::vector<ImageFile> files_;
   std::vector<std::int64_t> times_;  // the names' capture times, or none
+  FrameSizeCheck check_;
   std::size_t next_ = 0;
 };
 
@@ -171,17 +176,18 @@ pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems) 
   return {static_cast<int>(std::lround(fps * 1000)), 1000};
 }
 
-std::unique_ptr<FrameSource> open_frames(const InputSpec& input) {
+std::unique_ptr<FrameSource> open_frames(const InputSpec& input, FrameSizeCheck check) {
   if (input.rejected) throw *input.rejected;
   switch (input.kind) {
     case InputKind::image_pair:
-      return std::make_unique<ImageSequence>(name_images({fs::path(input.paths[0]), fs::path(input.paths[1])}));
+      return std::make_unique<ImageSequence>(name_images({fs::path(input.paths[0]), fs::path(input.paths[1])}),
+                                             std::move(check));
     case InputKind::image_folder: {
       auto images = list_images(input.paths[0]);
       if (images.empty()) {
         throw InputError(kExitNoInput, input.paths[0] + ": no image files (.png, .jpg, ...) in the folder");
       }
-      return std::make_unique<ImageSequence>(name_images(images));
+      return std::make_unique<ImageSequence>(name_images(images), std::move(check));
     }
     case InputKind::video: return std::make_unique<VideoFrames>(input.paths[0]);
   }

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/image_header.hpp"
 #include "convert/inputs.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/pipeline/frame_rate.hpp"
@@ -49,7 +50,8 @@ pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems);
 // empty otherwise.
 std::vector<std::int64_t> capture_times_ns(const std::vector<std::string>& stems);
 
-// Throws InputError when the input cannot be opened (missing, an empty folder…).
-std::unique_ptr<FrameSource> open_frames(const InputSpec& input);
+// Throws InputError when the input cannot be opened (missing, an empty folder…). An image whose
+// header states a size that `check` refuses is an InputError before it is decoded.
+std::unique_ptr<FrameSource> open_frames(const InputSpec& input, FrameSizeCheck check = {});
 
 }  // namespace neuflow::cli

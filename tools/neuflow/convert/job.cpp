@@ -138,7 +138,7 @@ bool may_resume(const fs::path& dir, const ConvertSettings& settings) {
 }
 
 void Conversion::run(InputOutcome& outcome) {
-  frames_ = open_frames(input_);
+  frames_ = open_frames(input_, [this](int w, int h) { return session_.frame_problem(w, h); });
   create_folder(dir_);
   if (settings_.resume) remove_stale_partials(dir_);
   resume_ = may_resume(dir_, settings_);

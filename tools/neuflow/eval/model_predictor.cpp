@@ -7,6 +7,7 @@
 #include <system_error>
 #include <utility>
 
+#include "common/image_header.hpp"
 #include "neuflow/eval/errors.hpp"
 
 namespace neuflow::eval {
@@ -24,10 +25,14 @@ std::string size_text(const cv::Mat& m) { return std::to_string(m.cols) + "x" + 
 
 }  // namespace
 
-cv::Mat read_bgr_image(const std::filesystem::path& path) {
+cv::Mat read_bgr_image(const std::filesystem::path& path, const model::FlowSession* session) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw EvalError(EvalError::Kind::missing_input, path.string() + ": no such image file");
+  }
+  if (session != nullptr) {
+    const auto check = [&](int w, int h) { return session->frame_problem(w, h); };
+    if (auto problem = cli::image_too_large(path, check)) throw EvalError(EvalError::Kind::malformed_input, *problem);
   }
   // IMREAD_COLOR: 8-bit BGR whatever the file holds (grey replicated, 16 bits scaled down).
   cv::Mat image = cv::imread(path.string(), cv::IMREAD_COLOR);
@@ -59,7 +64,7 @@ flow::FlowField ModelPredictor::predict(const cv::Mat& bgr0, const cv::Mat& bgr1
 }
 
 flow::FlowField ModelPredictor::operator()(const EvalSet& set, const Pair& pair) {
-  const cv::Mat image0 = read_bgr_image(pair.image0), image1 = read_bgr_image(pair.image1);
+  const cv::Mat image0 = read_bgr_image(pair.image0, &session_), image1 = read_bgr_image(pair.image1, &session_);
   if (image0.size() != image1.size()) {
     throw EvalError(EvalError::Kind::malformed_input, pair.image0.string() + " is " + size_text(image0) + " but " +
                                                           pair.image1.string() + " is " + size_text(image1));

@@ -65,6 +65,10 @@ class FlowSession {
   // and the limit), or nothing; push() and compute() refuse such frames with this message. A
   // GStreamer element asks at negotiation, before any frame.
   std::optional<std::string> memory_problem(int frame_width, int frame_height) const;
+  // Why push() and compute() would refuse frames of this size: a size the network cannot take
+  // (as their std::invalid_argument says it), or memory_problem(); nothing when they can. The
+  // command-line tools ask with an image's header before decoding it.
+  std::optional<std::string> frame_problem(int frame_width, int frame_height) const;
 
   // Where the network runs: "cpu" or "vulkan device 0 (NVIDIA H200)".
   const std::string& backend_description() const;

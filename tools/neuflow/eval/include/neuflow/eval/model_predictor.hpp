@@ -16,8 +16,9 @@
 namespace neuflow::eval {
 
 // An image as 8-bit BGR (grey and 16-bit images converted). Throws EvalError: missing_input
-// when the file is absent, malformed_input when OpenCV cannot decode it.
-cv::Mat read_bgr_image(const std::filesystem::path& path);
+// when the file is absent, malformed_input when OpenCV cannot decode it, or when `session`
+// could not take frames of the size its header states (checked before decoding).
+cv::Mat read_bgr_image(const std::filesystem::path& path, const model::FlowSession* session = nullptr);
 
 class ModelPredictor {
  public:
