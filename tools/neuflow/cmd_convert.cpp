@@ -42,6 +42,7 @@ struct ConvertArgs {
   std::string fps;     // --fps N or N/D
   std::string shard;   // --shard K/N
   std::string frames;  // --frames A:B
+  std::string padding = "centred";
 };
 
 // "A:B" with 0 <= A < B, or "A:" (to the end): the pairs whose first frame is A <= n < B.
@@ -134,7 +135,8 @@ CommandError interrupted(const InputSpec& input, const InputOutcome& outcome, st
 
 // What this run makes its flows with. The backend is the one the session opened (auto names
 // where it ran); the model, its content.
-OutputRecord record_of(const std::string& model_path, const std::string& format, const model::FlowSession& session) {
+OutputRecord record_of(const std::string& model_path, const std::string& format, const std::string& padding,
+                       const model::FlowSession& session) {
   const model::SessionOptions& o = session.options();
   const std::string& where = session.backend_description();
   std::string model_sha1;
@@ -151,7 +153,8 @@ OutputRecord record_of(const std::string& model_path, const std::string& format,
           std::string(model::channel_order_name(o.network_order)),
           where.substr(0, where.find(' ')),
           std::string(model::precision_name(o.precision)),
-          format};
+          format,
+          padding};
 }
 
 void run_convert(const ConvertArgs& a) {
@@ -164,6 +167,11 @@ void run_convert(const ConvertArgs& a) {
   const std::optional<FrameRange> frames = a.frames.empty() ? std::nullopt : std::optional(parse_frames(a.frames));
   if (frames && a.max_frames > 0)
     throw CommandError(kExitUsage, "--frames and --max-frames both limit the frames: give one");
+  if (a.padding == "bottom" && (options.model_width > 0 || options.model_height > 0)) {
+    throw CommandError(kExitUsage,
+                       "--padding bottom pads frames that run at their own size: leave out --model-width and "
+                       "--model-height (frames resized to a model size are not padded)");
+  }
 
   const std::string model_path = resolve_model(a.model, "convert");
   std::shared_ptr<const model::FlowModel> model;
@@ -184,7 +192,8 @@ void run_convert(const ConvertArgs& a) {
   settings.max_flow = a.max_flow;
   settings.resume = a.resume;
   settings.overwrite = a.overwrite;
-  settings.record = record_of(model_path, a.format, session);
+  settings.record = record_of(model_path, a.format, a.padding, session);
+  if (a.padding == "bottom") settings.padding = eval::PadMode::bottom;
   settings.max_frames = a.max_frames;
   settings.frames = frames;
   settings.image_rate = image_rate;
@@ -259,6 +268,13 @@ void register_convert(CLI::App& app) {
                   "Flow magnitude (px) drawn fully saturated in --viz; fixed so colours mean the same in every frame")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  sub->add_option("--padding", args->padding,
+                  "How frames that run at their own size are padded to multiples of 16: centred (edge pixels "
+                  "repeated evenly on each side, as the reference evaluation pads Sintel) or bottom (left and right "
+                  "evenly, every row at the bottom, as it pads KITTI). For flows `neuflow eval --predictions` scores, "
+                  "take the benchmark's: bottom for KITTI, centred for the others")
+      ->check(CLI::IsMember({"centred", "bottom"}))
+      ->capture_default_str();
   sub->add_flag("--resume", args->resume,
                 "Keep flow files that already exist and read back complete at the frames' size; compute the rest. "
                 "A folder whose settings.toml records other settings (model, iterations, model size, channel order, "

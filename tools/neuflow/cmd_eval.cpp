@@ -58,6 +58,8 @@ constexpr const char* kFooter =
     "root (training/ for Sintel and KITTI, data/ for FlyingChairs), extension replaced by .flo,\n"
     ".png (KITTI 16-bit) or .npy>, e.g. DIR/clean/alley_1/frame_0001.flo, DIR/image_2/000000_10.png,\n"
     "DIR/other-data/RubberWhale/frame10.flo, DIR/00001_img1.flo.\n"
+    "Flows from `neuflow convert` score as `eval -m` does only when padded as above: convert pads\n"
+    "centred by default; for KITTI give it --padding bottom (and no --model-width/--model-height).\n"
     "Progress goes to stderr, the table to stdout (to stderr with --json -).\n"
     "Exit status: 66 missing dataset, image, ground truth, prediction or model; 65 malformed\n"
     "input (undecodable, sizes that disagree); 73 JSON not writable; 1 otherwise.";

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "common/exit_codes.hpp"
 #include "common/image_header.hpp"
 #include "convert/frames.hpp"
-#include "common/exit_codes.hpp"
 #include "convert/input_error.hpp"
 #include "support/temp_dir.hpp"
 
@@ -27,8 +27,8 @@ std::vector<unsigned char> encoded(const char* extension, int width, int height)
 }
 
 void write(const std::filesystem::path& path, const std::vector<unsigned char>& bytes) {
-  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()),
-                                              static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
 TEST(ImageHeader, PngAndJpegSizesComeFromTheirHeaders) {

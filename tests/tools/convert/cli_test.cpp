@@ -288,6 +288,25 @@ TEST_F(ConvertCli, ResumeWithOtherSettingsIsRefusedNamingThemUnlessOverwrite) {
   EXPECT_NE(resumed.output.find("2 pairs (0 written, 2 skipped)"), std::string::npos) << resumed.output;
 }
 
+// A record from before --padding existed holds centred padding: it resumes with the default and
+// refuses --padding bottom, naming it.
+TEST_F(ConvertCli, ARecordWithoutPaddingMeansCentred) {
+  TempDir dir;
+  make_frames(dir / "seq", {"f1.png", "f2.png"});
+  const fs::path record = dir / "out" / "seq" / "settings.toml";
+  ASSERT_EQ(convert(dir / "out", {(dir / "seq").string()}).exit_code, 0);
+  std::string text = read_text(record);
+  const auto line = text.find("padding = 'centred'");
+  ASSERT_NE(line, std::string::npos) << text;
+  text.erase(line, text.find('\n', line) + 1 - line);
+  std::ofstream(record) << text;
+  const auto resumed = convert(dir / "out", {(dir / "seq").string(), "--resume"});
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
+  const auto refused = convert(dir / "out", {(dir / "seq").string(), "--resume", "--padding", "bottom"});
+  EXPECT_EQ(refused.exit_code, kExitUsage) << refused.output;
+  EXPECT_NE(refused.output.find("--padding centred (now bottom)"), std::string::npos) << refused.output;
+}
+
 TEST_F(ConvertCli, AFolderRecordThatIsNotOneIsNamed) {
   TempDir dir;
   make_frames(dir / "seq", {"f1.png", "f2.png"});

@@ -184,4 +184,29 @@ PY
 run_expect 0 --dataset middlebury "$Z" --model "$seed/checkpoint.pth" --threads 2 --iters-s8 1 --channel-order bgr --json -
 "$python" -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["channel_order"]=="bgr" and d["iters_s8"]==1, d' \
   "$work/stdout" || fail "model options in the JSON"
+
+# --- convert's flows scored as eval -m scores the model: on KITTI only with --padding bottom ---
+# eval pads KITTI at the bottom as the reference does; convert pads centred unless told.
+epe_of() { "$python" -c 'import json,sys; print(json.load(open(sys.argv[1]))["results"][0]["epe"])' "$1"; }
+run_expect 0 --dataset kitti "$K" --model "$seed/checkpoint.pth" --threads 2 --iters-s8 1 --json "$work/kitti-model.json"
+for padding in bottom centred; do
+  "$neuflow" convert -m "$seed/checkpoint.pth" --threads 2 --iters-s8 1 --padding "$padding" -o "$work/conv-$padding" \
+    "$K/image_2" 2>"$work/stderr" || fail "convert --padding $padding: $(cat "$work/stderr")"
+  [[ -f "$work/conv-$padding/image_2/000000_10.flo" ]] || fail "convert wrote no image_2/000000_10.flo"
+  run_expect 0 --dataset kitti "$K" --predictions "$work/conv-$padding" --json "$work/kitti-$padding.json"
+done
+"$python" - "$(epe_of "$work/kitti-model.json")" "$(epe_of "$work/kitti-bottom.json")" \
+  "$(epe_of "$work/kitti-centred.json")" <<'PY' || fail "convert --padding bottom does not score as eval -m on KITTI"
+import sys
+model, bottom, centred = map(float, sys.argv[1:])
+print(f"KITTI EPE: eval -m {model:.4f}, convert --padding bottom {bottom:.4f}, centred {centred:.4f}")
+assert abs(bottom - model) < 1e-3, (bottom, model)
+assert abs(centred - model) > 1e-3, "centred padding scored as bottom: the test cannot tell them apart"
+PY
+"$neuflow" convert -m "$seed/checkpoint.pth" --padding bottom --model-width 320 --model-height 256 -o "$work/x" \
+  "$K/image_2" 2>"$work/stderr"
+[[ $? -eq 64 ]] && grep -q "padding bottom pads frames that run at their own size" "$work/stderr" \
+  || fail "--padding bottom with a model size must be a usage error: $(cat "$work/stderr")"
+grep -q "padding" "$work/conv-bottom/image_2/settings.toml" || fail "the folder's record lacks the padding"
+"$neuflow" eval --help | grep -q -- "--padding bottom" || fail "eval --help does not say which padding convert needs"
 echo "all eval command checks passed"

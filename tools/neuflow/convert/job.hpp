@@ -22,6 +22,7 @@
 #include "convert/inputs.hpp"
 #include "convert/output_record.hpp"
 #include "convert/progress.hpp"
+#include "neuflow/eval/padding.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/pipeline/frame_rate.hpp"
@@ -53,6 +54,9 @@ struct ConvertSettings {
   // The rate of viz.mp4 for images (a video keeps its own): unset, the rate the file names'
   // timestamps give, else 10 frames per second.
   std::optional<pipeline::FrameRate> image_rate;
+  // --padding bottom: the frames padded here as the reference evaluation pads KITTI (all rows at
+  // the bottom) and the flow cropped back; unset, the session pads them centred itself.
+  std::optional<eval::PadMode> padding;
 };
 
 struct InputOutcome {

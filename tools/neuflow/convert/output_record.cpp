@@ -24,6 +24,7 @@ namespace {
 struct Field {
   const char* key;
   const char* option;
+  const char* absent;  // what a record without the key holds (one written before it existed); null: required
   std::function<std::string(const OutputRecord&)> text;
   std::function<void(OutputRecord&, const toml::node&)> read;
   std::function<void(toml::table&, const OutputRecord&)> write;
@@ -31,7 +32,7 @@ struct Field {
 
 template <typename T>
 Field field(const char* key, const char* option, T OutputRecord::*member) {
-  Field f{key, option, nullptr, nullptr, nullptr};
+  Field f{key, option, nullptr, nullptr, nullptr, nullptr};
   f.text = [member](const OutputRecord& r) {
     if constexpr (std::is_same_v<T, int>) {
       return std::to_string(r.*member);
@@ -71,6 +72,11 @@ const std::vector<Field>& fields() {
       field("backend", "--backend", &OutputRecord::backend),
       field("precision", "--precision", &OutputRecord::precision),
       field("format", "--format", &OutputRecord::format),
+      [] {
+        Field f = field("padding", "--padding", &OutputRecord::padding);
+        f.absent = "centred";
+        return f;
+      }(),
   };
   return all;
 }
@@ -88,8 +94,13 @@ std::optional<OutputRecord> read_record(const fs::path& folder) {
     OutputRecord r;
     for (const Field& f : fields()) {
       const toml::node* n = table.get(f.key);
-      if (!n) throw std::invalid_argument(std::string("no ") + f.key);
-      f.read(r, *n);
+      if (n) {
+        f.read(r, *n);
+      } else if (f.absent) {
+        f.read(r, toml::value<std::string>(f.absent));
+      } else {
+        throw std::invalid_argument(std::string("no ") + f.key);
+      }
     }
     return r;
   } catch (const toml::parse_error& e) {

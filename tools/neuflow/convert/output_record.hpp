@@ -15,6 +15,8 @@ struct OutputRecord {
   int iters_s16 = 0, iters_s8 = 0;
   int model_width = 0, model_height = 0;  // 0 × 0: each frame's own size, padded
   std::string channel_order, backend, precision, format;
+  // --padding: "centred" (also what a record from before the option means) or "bottom".
+  std::string padding = "centred";
   bool operator==(const OutputRecord&) const = default;
 };
 
