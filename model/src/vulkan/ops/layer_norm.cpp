@@ -15,7 +15,7 @@ void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op) {
                           op.weights->beta.offset};
   const long long read = in.count() + 2LL * in.c + (op.residual ? out.count() : 0);
   r.dispatch<Shader::layer_norm>({&r.weights(), in.buffer, out.buffer, residual.buffer}, p,
-                                 {r.bytes(read), r.bytes(out.count()), 0}, groups(tokens, kLocal));
+                                 {r.bytes(read), r.bytes(out.count()), 0}, groups(tokens, 16));
 }
 
 }  // namespace neuflow::model::vulkan
