@@ -8,7 +8,7 @@ void record_op(Recorder& r, const graph::LocalCorrelation& op) {
   r.dispatch<Shader::local_correlation>({f0.buffer, f1.buffer, out.buffer, flow.buffer}, p,
                                         {r.bytes(f0.count() + f1.count() + flow.count()), r.bytes(out.count()),
                                          static_cast<long long>(out.count()) * f0.c},
-                                        groups(static_cast<long>(out.h) * out.w, kLocal));
+                                        groups(static_cast<long>(out.h) * out.w, 16));
 }
 
 }  // namespace neuflow::model::vulkan
