@@ -91,12 +91,13 @@ std::optional<std::string> FlowSession::memory_problem(int frame_width, int fram
 }
 
 std::optional<std::string> FlowSession::frame_problem(int frame_width, int frame_height) const {
+  FrameGeometry g;
   try {
-    plan_geometry(frame_width, frame_height, options_);
+    g = plan_geometry(frame_width, frame_height, options_);
   } catch (const std::invalid_argument& e) {
     return std::string(e.what());
   }
-  return memory_problem(frame_width, frame_height);
+  return model::memory_problem(*state_->weights, options_, g.model_height, g.model_width);
 }
 
 const std::string& FlowSession::backend_description() const { return state_->backends->description(); }

@@ -29,6 +29,7 @@
 #include "neuflow/model/flow_model.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/model/gpu_devices.hpp"
+#include "support/flow_difference.hpp"
 
 namespace neuflow::model {
 namespace {
@@ -68,31 +69,7 @@ class Products {
   Products& operator=(const Products&) = delete;
 };
 
-struct Difference {
-  double max = 0, mean = 0;           // per component, px
-  double epe = 0, worst = 0;          // end-point error, mean and largest
-  double magnitude = 0, largest = 0;  // of the reference
-};
-
-Difference difference(const flow::FlowField& reference, const flow::FlowField& other) {
-  Difference d;
-  const std::size_t n = std::min(reference.pixel_count(), other.pixel_count());
-  for (std::size_t p = 0; p < n; ++p) {
-    const double du = other.uv[2 * p] - reference.uv[2 * p], dv = other.uv[2 * p + 1] - reference.uv[2 * p + 1];
-    d.max = std::max({d.max, std::fabs(du), std::fabs(dv)});
-    d.mean += (std::fabs(du) + std::fabs(dv)) / 2;
-    const double e = std::hypot(du, dv), m = std::hypot(reference.uv[2 * p], reference.uv[2 * p + 1]);
-    d.epe += e;
-    d.worst = std::max(d.worst, e);
-    d.magnitude += m;
-    d.largest = std::max(d.largest, m);
-  }
-  const double count = static_cast<double>(std::max<std::size_t>(n, 1));
-  d.mean /= count;
-  d.epe /= count;
-  d.magnitude /= count;
-  return d;
-}
+using Difference = test::FlowDifference;
 
 int failures = 0;
 
@@ -127,20 +104,22 @@ void check_parity(const std::shared_ptr<const FlowModel>& model, int device, con
   const flow::FlowField exact = cpu.compute(view(f0, s), view(f1, s));
   FlowSession fp32(model, options(device, Precision::fp32));
   const flow::FlowField gpu32 = fp32.compute(view(f0, s), view(f1, s));
-  check_exact("vulkan fp32 vs cpu" + at, difference(exact, gpu32));
+  check_exact("vulkan fp32 vs cpu" + at, test::flow_difference(exact, gpu32));
   if (!gpu.fp16) return;
   {
     const Products scalar("scalar");
     FlowSession fp16(model, options(device, Precision::fp16));
-    check_fp16("vulkan fp16 (scalar products) vs fp32" + at, difference(gpu32, fp16.compute(view(f0, s), view(f1, s))));
+    check_fp16("vulkan fp16 (scalar products) vs fp32" + at,
+               test::flow_difference(gpu32, fp16.compute(view(f0, s), view(f1, s))));
   }
   if (!gpu.tensor_cores) return;
   FlowSession cores(model, options(device, Precision::fp16));
   const flow::FlowField real = cores.compute(view(f0, s), view(f1, s));
-  check_fp16("tensor cores vs fp32" + at, difference(gpu32, real));
+  check_fp16("tensor cores vs fp32" + at, test::flow_difference(gpu32, real));
   const Products twin("twin");
   FlowSession emulated(model, options(device, Precision::fp16));
-  check_fp16("tensor cores vs their emulated twin" + at, difference(emulated.compute(view(f0, s), view(f1, s)), real));
+  check_fp16("tensor cores vs their emulated twin" + at,
+             test::flow_difference(emulated.compute(view(f0, s), view(f1, s)), real));
 }
 
 double milliseconds_since(std::chrono::steady_clock::time_point t0) {

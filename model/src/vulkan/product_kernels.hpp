@@ -19,15 +19,6 @@ namespace neuflow::model::vulkan {
 
 enum class ProductKernels { scalar, tensor_cores, twin };
 
-inline const char* product_kernels_name(ProductKernels k) {
-  switch (k) {
-    case ProductKernels::scalar: return "scalar";
-    case ProductKernels::tensor_cores: return "tensor-cores";
-    case ProductKernels::twin: return "twin";
-  }
-  return "scalar";
-}
-
 // Throws std::invalid_argument for a value it does not know, and BackendError (unavailable)
 // where the device or the precision cannot run what the variable asks for.
 inline ProductKernels product_kernels_for(const GpuDevice& device, bool fp16) {
@@ -62,6 +53,17 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
     case Shader::winograd_gemm: return cores ? Shader::winograd_gemm_coopmat : Shader::winograd_gemm_coopmat_twin;
     default: throw std::logic_error(std::string("product_shader: ") + shader_name(scalar) + " is not a product");
   }
+}
+
+// Whether a network whose products run on `kernels` records `shader`: every shader but the
+// other kernels' products.
+inline bool records(Shader shader, ProductKernels kernels) {
+  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::winograd_gemm}) {
+    for (const ProductKernels k : {ProductKernels::scalar, ProductKernels::tensor_cores, ProductKernels::twin}) {
+      if (product_shader(scalar, k) == shader) return k == kernels;
+    }
+  }
+  return true;
 }
 
 }  // namespace neuflow::model::vulkan

@@ -2,6 +2,7 @@
 
 #include "vulkan/conv_algorithm.hpp"
 #include "vulkan/device_weights.hpp"
+#include "vulkan/product_kernels.hpp"
 #include "vulkan/vulkan_instance.hpp"
 #include "vulkan/vulkan_network.hpp"
 
@@ -78,10 +79,10 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
   }
   auto context = std::make_shared<VulkanContext>();
   context->products = vulkan::product_kernels_for(device->info(), fp16);
-  if (fp16) {  // created now, so a driver that refuses one says so before the first frame
+  if (fp16) {  // those it records created now, so a driver that refuses one says so before the first frame
     for (std::size_t s = 0; s < vulkan::kShaderCount; ++s) {
       const auto shader = static_cast<vulkan::Shader>(s);
-      if (device->can_run(shader, true)) device->pipeline(shader, true);
+      if (vulkan::records(shader, context->products)) device->pipeline(shader, true);
     }
   }
   context->weights = vulkan::DeviceWeights::get(model, device, fp16, vulkan::winograd_from_environment());

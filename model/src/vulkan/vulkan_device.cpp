@@ -180,10 +180,10 @@ void VulkanDevice::create_pipelines() {
   layout.pPushConstantRanges = &push;
   check(vkCreatePipelineLayout(device_, &layout, nullptr, &pipeline_layout_), "vkCreatePipelineLayout");
 
-  // Those that exist in fp32 on every device now; the rest (fp16, tensor cores) on first use.
+  // Every fp32 pipeline this device can run now, so pipeline() reads them without a lock; the
+  // fp16 ones on first use.
   for (std::size_t s = 0; s < kShaderCount; ++s) {
-    const ShaderInfo& shader = shader_info(static_cast<Shader>(s));
-    if (!shader.spirv.empty() && !shader.tensor_cores) pipelines_[s] = create_pipeline(static_cast<Shader>(s), false);
+    if (can_run(static_cast<Shader>(s), false)) pipelines_[s] = create_pipeline(static_cast<Shader>(s), false);
   }
 }
 
@@ -223,11 +223,10 @@ VkPipeline VulkanDevice::pipeline(Shader shader, bool fp16) {
                                                             "' in " + (fp16 ? "fp16" : "fp32") +
                                                             " (it needs fp16 or tensor cores this device lacks)");
   }
-  if (!fp16 && pipelines_[s] != VK_NULL_HANDLE) return pipelines_[s];
+  if (!fp16) return pipelines_[s];
   const std::lock_guard lock(pipeline_mutex_);
-  VkPipeline& p = fp16 ? fp16_pipelines_[s] : pipelines_[s];
-  if (p == VK_NULL_HANDLE) p = create_pipeline(shader, fp16);
-  return p;
+  if (fp16_pipelines_[s] == VK_NULL_HANDLE) fp16_pipelines_[s] = create_pipeline(shader, true);
+  return fp16_pipelines_[s];
 }
 
 VulkanDevice::~VulkanDevice() { destroy(); }

@@ -60,8 +60,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   // nanoseconds per tick.
   uint32_t timestamp_bits() const { return timestamp_bits_; }
   double timestamp_period_ns() const { return timestamp_period_ns_; }
-  // The fp16 variants, and the shaders for tensor cores, are created on first use. Throws
-  // BackendError for a shader the device cannot run (can_run()).
+  // The fp16 variants are created on first use. Throws BackendError for a shader the device
+  // cannot run (can_run()).
   VkPipeline pipeline(Shader shader, bool fp16);
   // Whether the shader exists in that precision and the device has what it needs.
   bool can_run(Shader shader, bool fp16) const;

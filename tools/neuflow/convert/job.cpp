@@ -231,33 +231,25 @@ void Conversion::convert_pair(const Frame& from, const Frame& to, InputOutcome& 
 
 flow::FlowField Conversion::compute(const Frame& from, const Frame& to) {
   try {
-    // After a skipped pair the session's last frame is not this pair's first: start the
-    // stream again from it, so the result is the same as in an uninterrupted run.
-    if (!settings_.padding) {
-      if (!session_holds_from_) {
-        session_.reset();
-        session_.push(view_of(from));
-      }
-      auto field = session_.push(view_of(to));
-      session_holds_from_ = true;
-      if (!field) throw std::logic_error("the session returned no flow for a pair");
-      return std::move(*field);
-    }
-    // Padded here to multiples of 16 as eval pads the benchmark, so the session pads nothing.
-    const eval::Padding padding = eval::reference_padding(to.pixels.cols, to.pixels.rows, *settings_.padding);
-    const auto padded = [&](const Frame& f) {
+    // --padding bottom: padded here to multiples of 16 as eval pads the benchmark (the session
+    // then pads nothing) and the flow cropped back; otherwise the session pads them itself.
+    std::optional<eval::Padding> padding;
+    if (settings_.padding) padding = eval::reference_padding(to.pixels.cols, to.pixels.rows, *settings_.padding);
+    const auto prepared = [&](const Frame& f) {
       Frame p = f;
-      p.pixels = eval::pad_image(f.pixels, padding);
+      if (padding) p.pixels = eval::pad_image(f.pixels, *padding);
       return p;
     };
+    // After a skipped pair the session's last frame is not this pair's first: start the
+    // stream again from it, so the result is the same as in an uninterrupted run.
     if (!session_holds_from_) {
       session_.reset();
-      session_.push(view_of(padded(from)));
+      session_.push(view_of(prepared(from)));
     }
-    auto field = session_.push(view_of(padded(to)));
+    auto field = session_.push(view_of(prepared(to)));
     session_holds_from_ = true;
     if (!field) throw std::logic_error("the session returned no flow for a pair");
-    return eval::crop_flow(*field, padding);
+    return padding ? eval::crop_flow(*field, *padding) : std::move(*field);
   } catch (const std::invalid_argument& e) {
     throw InputError(kExitDataError, describe(from) + " -> " + describe(to) + ": " + e.what());
   }
