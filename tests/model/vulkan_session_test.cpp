@@ -108,17 +108,20 @@ TEST_F(VulkanSession, EveryStageEqualsTheCpuAtAnOddSizeAndOtherIterations) {
   EXPECT_LT(e.mean, 1e-3);
 }
 
-// The stride-1 3×3 convolutions by Winograd (the default, which every other test here runs)
-// and by the direct implicit GEMM (NEUFLOW_VULKAN_CONV=direct, the way back) give the CPU's
-// flow; a bad value is an error naming the variable.
-TEST_F(VulkanSession, DirectConvolutionsGiveTheCpusFlowToo) {
+// The stride-1 3×3 convolutions by the fused Winograd kernel (the default, which every other
+// test here runs), by Winograd in three dispatches (NEUFLOW_VULKAN_CONV=winograd-split, what the
+// tensor-core products take) and by the direct implicit GEMM (NEUFLOW_VULKAN_CONV=direct, the
+// way back) give the CPU's flow; a bad value is an error naming the variable.
+TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
   FlowSession cpu(model_, {.threads = 2, .backend = Backend::cpu});
   const auto expected = cpu.compute(view_of(frames_[0]), view_of(frames_[1]));
-  ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", "direct", 1), 0);
-  FlowSession direct(model_, {.backend = Backend::vulkan});
-  const Errors e = compare(direct.compute(view_of(frames_[0]), view_of(frames_[1])), expected);
-  EXPECT_LT(e.max, 1e-2);
-  EXPECT_LT(e.mean, 1e-3);
+  for (const char* conv : {"direct", "winograd-split"}) {
+    ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", conv, 1), 0);
+    FlowSession gpu(model_, {.backend = Backend::vulkan});
+    const Errors e = compare(gpu.compute(view_of(frames_[0]), view_of(frames_[1])), expected);
+    EXPECT_LT(e.max, 1e-2) << conv;
+    EXPECT_LT(e.mean, 1e-3) << conv;
+  }
   ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", "fast", 1), 0);
   try {
     FlowSession bad(model_, {.backend = Backend::vulkan});

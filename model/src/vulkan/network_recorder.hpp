@@ -37,9 +37,10 @@ inline uint32_t groups(long count, long per_group) {
   return static_cast<uint32_t>(std::clamp<long>((count + per_group - 1) / per_group, 1, 65535));
 }
 
-// The tiled products do not loop: each workgroup is one 64×64 tile, so the grid must fit.
-inline uint32_t tiles(long count, const char* what) {
-  const long n = (count + 63) / 64;
+// The tiled products do not loop: each workgroup is one tile (64 wide unless `per_group` says
+// otherwise), so the grid must fit.
+inline uint32_t tiles(long count, const char* what, long per_group = 64) {
+  const long n = (count + per_group - 1) / per_group;
   if (n > 65535) {
     throw BackendError(BackendError::Kind::unavailable, std::string("a model size too large for one dispatch of ") +
                                                             what + ": choose a smaller model-width/model-height");
@@ -205,7 +206,10 @@ class VulkanNetwork::Recorder {
   }
   const Buffer& weights() const { return net_.weights_->buffer; }
   const DeviceWeights& device_weights() const { return *net_.weights_; }
-  // F(4×4, 3×3)'s transformed input tiles and their products (fp32), which the Winograd
+  // Whether the Winograd convolutions run in three dispatches (the products on the product
+  // kernels) rather than fused in one (winograd_conv.comp).
+  bool split_winograd() const { return net_.split_winograd_; }
+  // F(4×4, 3×3)'s transformed input tiles and their products (fp32), which the split Winograd
   // convolutions use in turn.
   const Buffer& winograd_points() const { return net_.winograd_points_; }
   const Buffer& winograd_products() const { return net_.winograd_products_; }

@@ -11,6 +11,7 @@ namespace neuflow::model {
 struct VulkanContext {
   std::shared_ptr<const vulkan::DeviceWeights> weights;
   vulkan::ProductKernels products = vulkan::ProductKernels::scalar;
+  vulkan::ConvAlgorithm conv = vulkan::ConvAlgorithm::winograd_fused;
 };
 
 namespace {
@@ -18,7 +19,7 @@ namespace {
 class VulkanBackend final : public InferenceBackend {
  public:
   VulkanBackend(std::shared_ptr<VulkanContext> context, int height, int width)
-      : context_(std::move(context)), network_(context_->weights, height, width, context_->products) {}
+      : context_(std::move(context)), network_(context_->weights, height, width, context_->products, context_->conv) {}
   int width() const override { return network_.width(); }
   int height() const override { return network_.height(); }
   void encode(const Tensor& image, int slot) override { network_.encode(image, slot); }
@@ -85,7 +86,8 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
       if (vulkan::records(shader, context->products)) device->pipeline(shader, true);
     }
   }
-  context->weights = vulkan::DeviceWeights::get(model, device, fp16, vulkan::winograd_from_environment());
+  context->conv = vulkan::conv_algorithm_for(context->products);
+  context->weights = vulkan::DeviceWeights::get(model, device, fp16, context->conv != vulkan::ConvAlgorithm::direct);
   return context;
 }
 

@@ -13,17 +13,21 @@
 namespace neuflow::model::vulkan {
 
 VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width,
-                             ProductKernels products)
+                             ProductKernels products, ConvAlgorithm conv)
     : weights_(std::move(weights)),
       device_(*weights_->device),
       fp16_(weights_->fp16),
       products_(products),
+      split_winograd_(conv == ConvAlgorithm::winograd_split),
       elem_(fp16_ ? 2 : 4),
       height_(height),
       width_(width),
       tokens_((height / 16) * (width / 16)) {
   if (products_ != ProductKernels::scalar && !fp16_) {
     throw std::logic_error("VulkanNetwork: the tensor-core products take fp16 tensors");
+  }
+  if (products_ != ProductKernels::scalar && conv == ConvAlgorithm::winograd_fused) {
+    throw std::logic_error("VulkanNetwork: the fused Winograd convolution computes its products in scalar arithmetic");
   }
   block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
   graph_ = graph::build_network_graph<DeviceTensor>(*weights_, height, width, kPlanIterations, block_rows_);

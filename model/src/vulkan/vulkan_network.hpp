@@ -30,6 +30,7 @@
 #include "neuflow/model/session_settings.hpp"
 #include "neuflow/model/stage_observer.hpp"
 #include "tensor.hpp"
+#include "vulkan/conv_algorithm.hpp"
 #include "vulkan/device_weights.hpp"
 #include "vulkan/product_kernels.hpp"
 
@@ -50,9 +51,10 @@ class VulkanNetwork {
   static constexpr int kSlots = InferenceBackend::kSlots;  // frame features kept on the device
 
   // height, width: multiples of 16, at least 32. products: the kernels its products run on
-  // (product_kernels_for()). Throws BackendError (e.g. out of memory).
+  // (product_kernels_for()); conv: how the Winograd layers run where the weights have
+  // transformed filters (conv_algorithm_for()). Throws BackendError (e.g. out of memory).
   VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width,
-                ProductKernels products = ProductKernels::scalar);
+                ProductKernels products = ProductKernels::scalar, ConvAlgorithm conv = ConvAlgorithm::winograd_fused);
   ~VulkanNetwork();
   VulkanNetwork(const VulkanNetwork&) = delete;
   VulkanNetwork& operator=(const VulkanNetwork&) = delete;
@@ -152,11 +154,12 @@ class VulkanNetwork {
   VulkanDevice& device_;
   bool fp16_;  // tensors stored as float16_t
   ProductKernels products_;
-  std::size_t elem_;  // bytes per stored value: 4 or 2
+  bool split_winograd_;  // the Winograd layers in three dispatches through the two buffers below
+  std::size_t elem_;     // bytes per stored value: 4 or 2
   int height_, width_, tokens_, block_rows_;
 
   Buffer dummy_, zeros_;
-  Buffer winograd_points_, winograd_products_;  // sized for the largest Winograd convolution
+  Buffer winograd_points_, winograd_products_;  // sized for the largest split Winograd convolution
   std::array<Transfer, kRing> ring_;
   int next_entry_ = 0;
   std::deque<Started> started_;

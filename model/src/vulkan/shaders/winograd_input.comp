@@ -9,15 +9,7 @@ layout(std430, binding = 0) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Points { float points[]; };
 #include "params/winograd_input_params.h"
 
-// Bᵀ applied to six values.
-void input_1d(float d0, float d1, float d2, float d3, float d4, float d5, out float r[6]) {
-  r[0] = 4.0 * d0 - 5.0 * d2 + d4;
-  r[1] = d3 + d4 - 4.0 * (d1 + d2);
-  r[2] = d4 - d3 + 4.0 * (d1 - d2);
-  r[3] = d4 - d2 + 2.0 * (d3 - d1);
-  r[4] = d4 - d2 + 2.0 * (d1 - d3);
-  r[5] = 4.0 * d1 - 5.0 * d3 + d5;
-}
+#include "winograd_transforms.glsl"
 
 void main() {
   const int plane = p.h * p.w;

@@ -11,14 +11,7 @@ layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 #include "params/winograd_output_params.h"
 #include "activate.glsl"
 
-// Aᵀ applied to six values.
-void output_1d(float m0, float m1, float m2, float m3, float m4, float m5, out float o[4]) {
-  const float sum12 = m1 + m2, diff12 = m1 - m2, sum34 = m3 + m4, diff34 = m3 - m4;
-  o[0] = m0 + sum12 + sum34;
-  o[1] = diff12 + 2.0 * diff34;
-  o[2] = sum12 + 4.0 * sum34;
-  o[3] = diff12 + 8.0 * diff34 + m5;
-}
+#include "winograd_transforms.glsl"
 
 void main() {
   const int plane = p.h * p.w;
