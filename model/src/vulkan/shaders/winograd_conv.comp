@@ -4,14 +4,17 @@
 // A stride-1 3×3 convolution by F(4×4, 3×3) in one dispatch: the input tiles transformed as they
 // are loaded into workgroup memory, the 36 point products summed in registers, transformed back
 // with bias, addend and activation as they are stored. Neither the tiles nor the products go
-// through global memory, which the split path (winograd_input, winograd_gemm, winograd_output)
-// spends 4.5 fp32 bytes per input value and per output value on, each written and read again.
+// through global memory, where the split path (winograd_input, winograd_gemm, winograd_output)
+// writes and reads again 4.5 fp32 bytes per input value and per output value.
 //
-// A workgroup: 32 tiles × 16 output channels; an invocation: 2 tiles × 1 channel, 72 sums.
-// Input channels in steps of 4, each step's transformed tiles (36 × 4 × 32) and filters
-// (36 × 16 × 4) staged in fp32 workgroup memory: 27 KiB, inside the 32 KiB every desktop GPU,
-// Jetson and lavapipe has.
-layout(local_size_x = 16, local_size_y = 16) in;
+// A workgroup: 32 tiles × 16 output channels, in 192 invocations. The 36 points are 6 rows of
+// the 6×6 products; an invocation sums one row (6 points) of 4 channels × 4 tiles, so each
+// point's product is register-blocked 4×4 as a tiled GEMM is (8 loads a 16 multiply-adds), in
+// 96 sums. Input channels in steps of 4: the step's transformed tiles (36 × 4 × 32) and filters
+// (36 × 4 × 16) staged in 27 KiB of workgroup memory, inside the 32 KiB every desktop GPU,
+// Jetson and lavapipe has. At the end each invocation applies A to its row (6 points → 4), and
+// the rows meet in workgroup memory, in two rounds of 16 tiles, for Aᵀ.
+layout(local_size_x = 192) in;
 layout(std430, binding = 0) readonly buffer Filters { VALUE u[]; };
 layout(std430, binding = 1) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
@@ -21,11 +24,13 @@ layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 #include "winograd_transforms.glsl"
 
 const int TILES = 32, CHANNELS = 16, STEP = 4;
-shared float points[36][STEP][TILES];     // Bᵀ d B of each staged channel and tile
-shared float filters[36][CHANNELS][STEP];  // G g Gᵀ of each (output, input) channel pair
+const int FILTERS = 36 * STEP * TILES;  // where the staged filters start
+// The staged tiles [36][STEP][TILES] and filters [36][STEP][CHANNELS]; at the end, the rows
+// transformed by A: [CHANNELS][16 tiles][6 rows][4].
+shared float staged[36 * STEP * (TILES + CHANNELS)];
 
 // Transforms channel `ci` of tile `t` (zeros past the input, and for tiles and channels past
-// the last) into points[·][k][slot].
+// the last) into the staged tiles at step channel k, slot `slot`.
 void stage_tile(int ci, int t, int k, int slot) {
   float d[6][6];
   const bool inside = ci < p.in_c && t < p.tiles;
@@ -48,65 +53,82 @@ void stage_tile(int ci, int t, int k, int slot) {
   for (int i = 0; i < 6; ++i) {  // (Bᵀ d) B
     float r[6];
     input_1d(cols[i][0], cols[i][1], cols[i][2], cols[i][3], cols[i][4], cols[i][5], r);
-    for (int j = 0; j < 6; ++j) points[6 * i + j][k][slot] = r[j];
+    for (int j = 0; j < 6; ++j) staged[((6 * i + j) * STEP + k) * TILES + slot] = r[j];
   }
 }
 
-// Aᵀ m A of tile `t`'s 36 sums for output channel `co`, then bias, addend, activation.
-void store_tile(int co, int t, float m[36]) {
+// Aᵀ of output channel `co`, tile `t`, from its 6 rows transformed by A (at `at` in staged),
+// then bias, addend and activation.
+void store_tile(int co, int t, int at) {
   if (co >= p.out_c || t >= p.tiles) return;
   const int ty = t / p.tiles_x, tx = t - ty * p.tiles_x;
-  float rows[6][4];  // m A
-  for (int i = 0; i < 6; ++i) {
-    float o[4];
-    output_1d(m[6 * i], m[6 * i + 1], m[6 * i + 2], m[6 * i + 3], m[6 * i + 4], m[6 * i + 5], o);
-    for (int j = 0; j < 4; ++j) rows[i][j] = o[j];
-  }
   const float bias = p.bias_off >= 0 ? float(u[p.bias_off + co]) : 0.0;
   const int plane = p.h * p.w;
-  for (int j = 0; j < 4; ++j) {  // Aᵀ (m A)
+  for (int j = 0; j < 4; ++j) {
     float o[4];
-    output_1d(rows[0][j], rows[1][j], rows[2][j], rows[3][j], rows[4][j], rows[5][j], o);
+    output_1d(staged[at + j], staged[at + 4 + j], staged[at + 8 + j], staged[at + 12 + j], staged[at + 16 + j],
+              staged[at + 20 + j], o);
     const int x = 4 * tx + j;
     if (x >= p.w) continue;
     for (int r = 0; r < 4; ++r) {
       const int y = 4 * ty + r;
       if (y >= p.h) continue;
-      const int at = co * plane + y * p.w + x;
+      const int i = co * plane + y * p.w + x;
       float v = o[r] + bias;
-      if (p.add_off >= 0) v += float(addend[p.add_off + at]);
-      dst[p.out_off + at] = VALUE(activate(v, p.act));
+      if (p.add_off >= 0) v += float(addend[p.add_off + i]);
+      dst[p.out_off + i] = VALUE(activate(v, p.act));
     }
   }
 }
 
 void main() {
-  const int lx = int(gl_LocalInvocationID.x), ly = int(gl_LocalInvocationID.y);
-  const int id = ly * 16 + lx;
+  const int id = int(gl_LocalInvocationIndex);
+  const int row = id / 32, position = id % 32;
+  const int cg = position / 8, tg = position % 8;  // channels o0 + cg + 4a, tiles t0 + tg + 8b
   const int t0 = int(gl_WorkGroupID.x) * TILES, o0 = int(gl_WorkGroupID.y) * CHANNELS;
-  float m0[36], m1[36];  // the sums of tiles t0 + lx and t0 + lx + 16, output channel o0 + ly
-  for (int i = 0; i < 36; ++i) {
-    m0[i] = 0.0;
-    m1[i] = 0.0;
-  }
+  float m[6][4][4];  // points 6·row + j, channel a, tile b
+  for (int j = 0; j < 6; ++j)
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b) m[j][a][b] = 0.0;
+
   for (int c0 = 0; c0 < p.in_c; c0 += STEP) {
     if (id < STEP * TILES) stage_tile(c0 + id / TILES, t0 + id % TILES, id / TILES, id % TILES);
-    for (int e = id; e < 36 * CHANNELS * STEP; e += 256) {  // adjacent invocations, adjacent input channels
-      const int k = e % STEP, o = (e / STEP) % CHANNELS, point = e / (STEP * CHANNELS);
+    for (int e = id; e < 36 * STEP * CHANNELS; e += 192) {
+      const int o = e % CHANNELS, k = (e / CHANNELS) % STEP, point = e / (CHANNELS * STEP);
       const int co = o0 + o, ci = c0 + k;
-      filters[point][o][k] =
+      staged[FILTERS + e] =
           co < p.out_c && ci < p.in_c ? float(u[p.filters_off + (point * p.out_c + co) * p.in_c + ci]) : 0.0;
     }
     barrier();
-    for (int i = 0; i < 36; ++i) {
+    for (int j = 0; j < 6; ++j) {
+      const int point = 6 * row + j;
       for (int k = 0; k < STEP; ++k) {
-        const float f = filters[i][ly][k];
-        m0[i] = fma(f, points[i][k][lx], m0[i]);
-        m1[i] = fma(f, points[i][k][lx + 16], m1[i]);
+        float f[4], t[4];
+        for (int a = 0; a < 4; ++a) f[a] = staged[FILTERS + (point * STEP + k) * CHANNELS + cg + 4 * a];
+        for (int b = 0; b < 4; ++b) t[b] = staged[(point * STEP + k) * TILES + tg + 8 * b];
+        for (int a = 0; a < 4; ++a)
+          for (int b = 0; b < 4; ++b) m[j][a][b] = fma(f[a], t[b], m[j][a][b]);
       }
     }
     barrier();
   }
-  store_tile(o0 + ly, t0 + lx, m0);
-  store_tile(o0 + ly, t0 + lx + 16, m1);
+
+  // Two rounds: tiles tg + 8b for b in {0, 1}, then {2, 3} (16 tiles each).
+  for (int round = 0; round < 2; ++round) {
+    for (int a = 0; a < 4; ++a) {
+      for (int bb = 0; bb < 2; ++bb) {
+        const int b = 2 * round + bb;
+        float o[4];  // this row of the products times A
+        output_1d(m[0][a][b], m[1][a][b], m[2][a][b], m[3][a][b], m[4][a][b], m[5][a][b], o);
+        const int pair = (cg + 4 * a) * 16 + tg + 8 * bb;
+        for (int q = 0; q < 4; ++q) staged[(pair * 6 + row) * 4 + q] = o[q];
+      }
+    }
+    barrier();
+    for (int pair = id; pair < CHANNELS * 16; pair += 192) {
+      const int o = pair / 16, slot = pair % 16;
+      store_tile(o0 + o, t0 + 16 * round + slot, pair * 24);
+    }
+    barrier();
+  }
 }
