@@ -30,9 +30,9 @@ struct Budget {
 // it weights (the 1/8 refinement reads its own at every step).
 constexpr Budget kDirect{165, 163, 75.1e6};
 // At 160×128 with the 1/8 layers' stride-1 3×3 convolutions by Winograd, fused: one dispatch
-// each, as the direct convolution; the transformed filters (four times the size of the
-// filters) are most of the bytes at this size.
-constexpr Budget kWinograd{165, 163, 231.0e6};
+// each, reading and writing what the direct convolution does (the filters as their 9 taps,
+// transformed as they are loaded), so the same bytes as direct convolutions at this size.
+constexpr Budget kWinograd{165, 163, 105.7e6};
 // The same in three dispatches each (NEUFLOW_VULKAN_CONV=winograd-split, as the tensor-core
 // products run), the tiles and products through memory in fp32.
 constexpr Budget kWinogradSplit{321, 316, 334.1e6};

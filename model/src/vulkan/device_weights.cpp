@@ -53,14 +53,11 @@ struct Packer {
   }
   void convolution(const ConvWeights& host, const DeviceConv& device) {
     if (!winograd || host.kernel_h != 3 || host.kernel_w != 3) return;
-    DeviceWeights::WinogradFilters w;
-    w.filters = filters.add(winograd_f43_filters(host));
-    if (!host.bias.empty()) w.bias = filters.add(host.bias);
-    winograd_filters.emplace(device.weight.offset, w);
+    winograd_filters.emplace(device.weight.offset, filters.add(winograd_f43_filters(host)));
   }
   bool winograd = false;
   Packed weights, filters;
-  std::map<int, DeviceWeights::WinogradFilters> winograd_filters;
+  std::map<int, int> winograd_filters;
 };
 
 // `values` in a device buffer of their own, in the tensors' precision.

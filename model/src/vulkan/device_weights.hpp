@@ -29,24 +29,14 @@ struct DeviceWeights : BasicNetworkWeights<DeviceTensor> {
   bool fp16 = false;  // stored as float16_t (offsets count elements either way)
   Buffer buffer;
   // With Winograd: each 3×3 convolution's filters transformed for F(4×4, 3×3) (G g Gᵀ), as
-  // [36][out][in] in winograd_buffer, followed by a copy of its bias (-1: none), so the fused
-  // convolution reads both through one binding. By the offset of its weight; empty with direct
-  // convolutions.
-  struct WinogradFilters {
-    int filters = -1, bias = -1;
-  };
-  std::map<int, WinogradFilters> winograd_filters;
+  // [36][out][in] in winograd_buffer, by the offset of its weight. Empty with direct convolutions.
+  std::map<int, int> winograd_filters;
   Buffer winograd_buffer;
 
   // The transformed filters of `conv`, or -1 where it has none.
   int winograd_filters_of(const DeviceConv& conv) const {
     const auto it = winograd_filters.find(conv.weight.offset);
-    return it == winograd_filters.end() ? -1 : it->second.filters;
-  }
-  // Its bias in winograd_buffer, or -1 where it has none.
-  int winograd_bias_of(const DeviceConv& conv) const {
-    const auto it = winograd_filters.find(conv.weight.offset);
-    return it == winograd_filters.end() ? -1 : it->second.bias;
+    return it == winograd_filters.end() ? -1 : it->second;
   }
 
   // The weights of `model` on `device` in that precision, uploaded on first use.

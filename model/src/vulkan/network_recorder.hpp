@@ -206,9 +206,8 @@ class VulkanNetwork::Recorder {
   }
   const Buffer& weights() const { return net_.weights_->buffer; }
   const DeviceWeights& device_weights() const { return *net_.weights_; }
-  // Whether the Winograd convolutions run in three dispatches (the products on the product
-  // kernels) rather than fused in one (winograd_conv.comp).
-  bool split_winograd() const { return net_.split_winograd_; }
+  // How the stride-1 3×3 convolutions run (conv_algorithm.hpp).
+  ConvAlgorithm conv_algorithm() const { return net_.conv_; }
   // F(4×4, 3×3)'s transformed input tiles and their products (fp32), which the split Winograd
   // convolutions use in turn.
   const Buffer& winograd_points() const { return net_.winograd_points_; }

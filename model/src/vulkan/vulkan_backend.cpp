@@ -87,7 +87,8 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
     }
   }
   context->conv = vulkan::conv_algorithm_for(context->products);
-  context->weights = vulkan::DeviceWeights::get(model, device, fp16, context->conv != vulkan::ConvAlgorithm::direct);
+  context->weights =
+      vulkan::DeviceWeights::get(model, device, fp16, context->conv == vulkan::ConvAlgorithm::winograd_split);
   return context;
 }
 

@@ -18,7 +18,7 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
       device_(*weights_->device),
       fp16_(weights_->fp16),
       products_(products),
-      split_winograd_(conv == ConvAlgorithm::winograd_split),
+      conv_(conv),
       elem_(fp16_ ? 2 : 4),
       height_(height),
       width_(width),
@@ -28,6 +28,9 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   }
   if (products_ != ProductKernels::scalar && conv == ConvAlgorithm::winograd_fused) {
     throw std::logic_error("VulkanNetwork: the fused Winograd convolution computes its products in scalar arithmetic");
+  }
+  if (conv == ConvAlgorithm::winograd_split && weights_->winograd_filters.empty()) {
+    throw std::logic_error("VulkanNetwork: the split Winograd convolution needs the filters transformed at upload");
   }
   block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
   graph_ = graph::build_network_graph<DeviceTensor>(*weights_, height, width, kPlanIterations, block_rows_);

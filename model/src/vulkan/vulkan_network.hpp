@@ -154,8 +154,8 @@ class VulkanNetwork {
   VulkanDevice& device_;
   bool fp16_;  // tensors stored as float16_t
   ProductKernels products_;
-  bool split_winograd_;  // the Winograd layers in three dispatches through the two buffers below
-  std::size_t elem_;     // bytes per stored value: 4 or 2
+  ConvAlgorithm conv_;  // split Winograd goes through the two buffers below
+  std::size_t elem_;    // bytes per stored value: 4 or 2
   int height_, width_, tokens_, block_rows_;
 
   Buffer dummy_, zeros_;

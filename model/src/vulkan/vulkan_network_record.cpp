@@ -87,7 +87,7 @@ void VulkanNetwork::allocate_tensors() {
       const auto* conv = std::get_if<graph::Conv2d<DeviceTensor>>(&node.op);
       if (!conv) continue;
       const graph::TensorDesc& out = graph_.tensors.at(conv->out.tensor);
-      if (!split_winograd_ || !takes_winograd(*weights_, *conv, out.h, out.w)) continue;
+      if (conv_ != ConvAlgorithm::winograd_split || !takes_winograd(conv_, *conv, out.h, out.w)) continue;
       const std::size_t tiles = static_cast<std::size_t>(winograd_tiles(out.w)) * winograd_tiles(out.h);
       points = std::max(points, 36 * static_cast<std::size_t>(conv->in.c) * tiles);
       products = std::max(products, 36 * static_cast<std::size_t>(conv->out.c) * tiles);

@@ -5,13 +5,12 @@ namespace neuflow::model::vulkan {
 
 namespace {
 
-// F(4×4, 3×3) in one dispatch (winograd_conv.comp): the tiles transformed as they are loaded,
-// the products transformed back with bias, addend and activation as they are stored. It reads
-// the input, the transformed filters (4× the filters) and the addend, and writes the output.
+// F(4×4, 3×3) in one dispatch (winograd_conv.comp): the filters and tiles transformed as they
+// are loaded, the products transformed back with bias, addend and activation as they are
+// stored. It reads what the direct convolution reads and writes what it writes.
 void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
                            const View& addend) {
   const DeviceConv& w = *op.weights;
-  const DeviceWeights& weights = r.device_weights();
   const int tiles_x = winograd_tiles(out.w), tile_count = tiles_x * winograd_tiles(out.h);
   const WinogradConvParams p{in.c,
                              in.h,
@@ -21,14 +20,14 @@ void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, c
                              out.offset(),
                              tiles_x,
                              tile_count,
-                             weights.winograd_filters_of(w),
-                             weights.winograd_bias_of(w),
+                             w.weight.offset,
+                             w.bias.offset,
                              op.addend ? addend.offset() : -1,
                              activation_code(op.act)};
-  const long long filters = 36LL * out.c * in.c;
-  const long long read = in.count() + filters + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
-  r.dispatch<Shader::winograd_conv>({&weights.winograd_buffer, in.buffer, out.buffer, addend.buffer}, p,
-                                    {r.bytes(read), r.bytes(out.count()), filters * tile_count},
+  const long long taps = 9LL * out.c * in.c, points = 36LL * out.c * in.c;
+  const long long read = in.count() + taps + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
+  r.dispatch<Shader::winograd_conv>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
+                                    {r.bytes(read), r.bytes(out.count()), points * tile_count},
                                     tiles(tile_count, "a convolution", 32), tiles(out.c, "a convolution", 16));
 }
 
@@ -76,8 +75,8 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
   const DeviceConv& w = *op.weights;
   const View in = r.view(op.in), out = r.view(op.out);
   const View addend = op.addend ? r.view(*op.addend) : View{};
-  if (takes_winograd(r.device_weights(), op, out.h, out.w)) {
-    if (r.split_winograd()) {
+  if (takes_winograd(r.conv_algorithm(), op, out.h, out.w)) {
+    if (r.conv_algorithm() == ConvAlgorithm::winograd_split) {
       record_winograd(r, op, in, out, addend);
     } else {
       record_winograd_fused(r, op, in, out, addend);

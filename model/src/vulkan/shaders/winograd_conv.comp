@@ -1,11 +1,12 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "precision.glsl"
-// A stride-1 3×3 convolution by F(4×4, 3×3) in one dispatch: the input tiles transformed as they
-// are loaded into workgroup memory, the 36 point products summed in registers, transformed back
-// with bias, addend and activation as they are stored. Neither the tiles nor the products go
-// through global memory, where the split path (winograd_input, winograd_gemm, winograd_output)
-// writes and reads again 4.5 fp32 bytes per input value and per output value.
+// A stride-1 3×3 convolution by F(4×4, 3×3) in one dispatch: the input tiles and the filters
+// transformed as they are loaded into workgroup memory, the 36 point products summed in
+// registers, transformed back with bias, addend and activation as they are stored. Neither the
+// tiles nor the products go through global memory, where the split path (winograd_input,
+// winograd_gemm, winograd_output) writes and reads again 4.5 fp32 bytes per input value and per
+// output value; the filters are read as their 9 taps, not as 36 transformed points.
 //
 // A workgroup: 32 tiles × 16 output channels, in 192 invocations. The 36 points are 6 rows of
 // the 6×6 products; an invocation sums one row (6 points) of 4 channels × 4 tiles, so each
@@ -15,7 +16,7 @@
 // Jetson and lavapipe has. At the end each invocation applies A to its row (6 points → 4), and
 // the rows meet in workgroup memory, in two rounds of 16 tiles, for Aᵀ.
 layout(local_size_x = 192) in;
-layout(std430, binding = 0) readonly buffer Filters { VALUE u[]; };
+layout(std430, binding = 0) readonly buffer Weights { VALUE u[]; };
 layout(std430, binding = 1) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
@@ -57,6 +58,28 @@ void stage_tile(int ci, int t, int k, int slot) {
   }
 }
 
+// G g Gᵀ of the filter from step channel k (c0 + k) to output channel o (o0 + o), pair
+// o + CHANNELS · k, into the staged filters (zeros for channels past the last).
+void stage_filter(int o0, int c0, int pair) {
+  const int o = pair % CHANNELS, k = pair / CHANNELS;
+  const int co = o0 + o, ci = c0 + k;
+  const bool inside = co < p.out_c && ci < p.in_c;
+  const int base = p.w_off + (co * p.in_c + ci) * 9;
+  float g[9];
+  for (int t = 0; t < 9; ++t) g[t] = inside ? float(u[base + t]) : 0.0;
+  float cols[6][3];  // G g
+  for (int x = 0; x < 3; ++x) {
+    float r[6];
+    filter_1d(g[x], g[3 + x], g[6 + x], r);
+    for (int i = 0; i < 6; ++i) cols[i][x] = r[i];
+  }
+  for (int i = 0; i < 6; ++i) {  // (G g) Gᵀ
+    float r[6];
+    filter_1d(cols[i][0], cols[i][1], cols[i][2], r);
+    for (int j = 0; j < 6; ++j) staged[FILTERS + ((6 * i + j) * STEP + k) * CHANNELS + o] = r[j];
+  }
+}
+
 // Aᵀ of output channel `co`, tile `t`, from its 6 rows transformed by A (at `at` in staged),
 // then bias, addend and activation.
 void store_tile(int co, int t, int at) {
@@ -93,12 +116,7 @@ void main() {
 
   for (int c0 = 0; c0 < p.in_c; c0 += STEP) {
     if (id < STEP * TILES) stage_tile(c0 + id / TILES, t0 + id % TILES, id / TILES, id % TILES);
-    for (int e = id; e < 36 * STEP * CHANNELS; e += 192) {
-      const int o = e % CHANNELS, k = (e / CHANNELS) % STEP, point = e / (CHANNELS * STEP);
-      const int co = o0 + o, ci = c0 + k;
-      staged[FILTERS + e] =
-          co < p.out_c && ci < p.in_c ? float(u[p.filters_off + (point * p.out_c + co) * p.in_c + ci]) : 0.0;
-    }
+    if (id >= 192 - STEP * CHANNELS) stage_filter(o0, c0, id - (192 - STEP * CHANNELS));
     barrier();
     for (int j = 0; j < 6; ++j) {
       const int point = 6 * row + j;

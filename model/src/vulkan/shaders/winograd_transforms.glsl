@@ -1,5 +1,17 @@
-// F(4×4, 3×3)'s input and output transforms along one dimension (Bᵀ and Aᵀ), shared by the split
-// shaders (winograd_input.comp, winograd_output.comp) and the fused one (winograd_conv.comp).
+// F(4×4, 3×3)'s transforms along one dimension (G, Bᵀ and Aᵀ), shared by the split shaders
+// (winograd_input.comp, winograd_output.comp) and the fused one (winograd_conv.comp), which
+// also transforms the filters (the split path's are transformed at upload, in double:
+// winograd::F43::filter_1d, whose coefficients these are).
+
+// G applied to three taps.
+void filter_1d(float a, float b, float c, out float r[6]) {
+  r[0] = a / 4.0;
+  r[1] = -(a + b + c) / 6.0;
+  r[2] = -(a - b + c) / 6.0;
+  r[3] = a / 24.0 + b / 12.0 + c / 6.0;
+  r[4] = a / 24.0 - b / 12.0 + c / 6.0;
+  r[5] = c;
+}
 
 // Bᵀ applied to six values.
 void input_1d(float d0, float d1, float d2, float d3, float d4, float d5, out float r[6]) {
