@@ -139,7 +139,7 @@ say "every target built in Ubuntu 22.04 with the $preset preset ($(( $(date +%s)
 # and the CLI's Vulkan failures run here, and it runs both again on more frames.
 lavapipe_repeats='NetworkReference\.EveryStageMatchesTheReference/vulkan|VulkanSession\.(StreamingGivesTheSameFlowAsPairs'
 lavapipe_repeats+='|Fp16StaysWithinItsBoundOfFp32|FramesConvertedOnTheDeviceGiveTheCpusFlow|DeviceTimestampsTimeEveryStageOfAFrame)'
-lavapipe_repeats+='|VulkanSession\.DirectConvolutionsGiveTheCpusFlowToo'
+lavapipe_repeats+='|VulkanSession\.EveryWayOfConvolvingGivesTheCpusFlow'
 # The device-work counts are host code: one test of them runs here, the rest repeat lavapipe runs.
 lavapipe_repeats+='|VulkanWork\.(WinogradComputesFewerMultiplyAdds|APipelinedFrameTakesOneSubmissionAndOneWait'
 lavapipe_repeats+='|Fp16HalvesTheTensorsBytes|AnObservedPassIsNotCounted)'
