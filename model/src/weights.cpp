@@ -1,9 +1,11 @@
 #include "weights.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "neuflow/model/architecture.hpp"
 
@@ -104,6 +106,24 @@ class WeightReader {
     return {spec.out, spec.in, tensor(name + ".weight", {spec.out, spec.in}), bias(name, spec)};
   }
 
+  // Linear layers of one input size as one, their outputs one after the other; a layer without
+  // a bias contributes zeros where the others have one.
+  static LinearWeights stacked(const std::vector<LinearWeights>& layers) {
+    LinearWeights s{0, layers.front().in_features, {}, {}};
+    const bool any_bias = std::any_of(layers.begin(), layers.end(), [](const auto& l) { return !l.bias.empty(); });
+    for (const LinearWeights& l : layers) {
+      s.out_features += l.out_features;
+      s.weight.insert(s.weight.end(), l.weight.begin(), l.weight.end());
+      if (!any_bias) continue;
+      if (l.bias.empty()) {
+        s.bias.insert(s.bias.end(), static_cast<std::size_t>(l.out_features), 0.f);
+      } else {
+        s.bias.insert(s.bias.end(), l.bias.begin(), l.bias.end());
+      }
+    }
+    return s;
+  }
+
   LayerNormWeights layer_norm(const std::string& name) const {
     const int dim = layer(name, LayerKind::layer_norm).out;
     return {tensor(name + ".weight", {dim}), tensor(name + ".bias", {dim})};
@@ -111,12 +131,11 @@ class WeightReader {
 
   AttentionLayerWeights attention_layer(const std::string& prefix) const {
     AttentionLayerWeights a;
-    a.q_proj = linear(prefix + ".q_proj");
-    const float scale = static_cast<float>(1.0 / std::sqrt(static_cast<double>(a.q_proj.in_features)));
-    for (float& w : a.q_proj.weight) w *= scale;
-    for (float& b : a.q_proj.bias) b *= scale;
-    a.k_proj = linear(prefix + ".k_proj");
-    a.v_proj = linear(prefix + ".v_proj");
+    LinearWeights q = linear(prefix + ".q_proj");
+    const float scale = static_cast<float>(1.0 / std::sqrt(static_cast<double>(q.in_features)));
+    for (float& w : q.weight) w *= scale;
+    for (float& b : q.bias) b *= scale;
+    a.qkv_proj = stacked({q, linear(prefix + ".k_proj"), linear(prefix + ".v_proj")});
     a.merge = linear(prefix + ".merge");
     a.norm1 = layer_norm(prefix + ".norm1");
     a.mlp0 = linear(prefix + ".mlp.0");

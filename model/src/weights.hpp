@@ -50,9 +50,10 @@ struct BasicConvBlockWeights {
 
 template <typename T>
 struct BasicAttentionLayerWeights {
-  BasicLinearWeights<T> q_proj;  // scaled by 1/sqrt(192)
-  BasicLinearWeights<T> k_proj;
-  BasicLinearWeights<T> v_proj;
+  // q_proj (scaled by 1/sqrt(192)), k_proj and v_proj stacked: [576, 192]. Each frame's tokens
+  // are projected once into all three, which its own queries and the other frame's keys and
+  // values both take: one product a frame where there were three.
+  BasicLinearWeights<T> qkv_proj;
   BasicLinearWeights<T> merge;
   BasicLayerNormWeights<T> norm1;
   BasicLinearWeights<T> mlp0;  // 384 → 384, no bias
@@ -122,9 +123,8 @@ BasicConvBlockWeights<B> map_weights(const BasicConvBlockWeights<A>& w, F& f) {
 }
 template <typename B, typename A, typename F>
 BasicAttentionLayerWeights<B> map_weights(const BasicAttentionLayerWeights<A>& w, F& f) {
-  return {map_weights<B>(w.q_proj, f), map_weights<B>(w.k_proj, f), map_weights<B>(w.v_proj, f),
-          map_weights<B>(w.merge, f),  map_weights<B>(w.norm1, f),  map_weights<B>(w.mlp0, f),
-          map_weights<B>(w.mlp2, f),   map_weights<B>(w.norm2, f)};
+  return {map_weights<B>(w.qkv_proj, f), map_weights<B>(w.merge, f), map_weights<B>(w.norm1, f),
+          map_weights<B>(w.mlp0, f),     map_weights<B>(w.mlp2, f),  map_weights<B>(w.norm2, f)};
 }
 template <typename B, typename A, typename F>
 BasicRefineWeights<B> map_weights(const BasicRefineWeights<A>& w, F& f) {

@@ -52,29 +52,35 @@ class Builder {
     conv(w.conv2, layer + ".conv2", all(mid), out, 1, 1, Activation::leaky_relu);
   }
 
-  // One cross-attention layer: `source`'s tokens attend to `target`'s.
-  void attention_layer(const BasicAttentionLayerWeights<T>& w, const std::string& layer, const std::string& frame,
-                       TensorId source, TensorId target, TensorId out) {
-    const std::string at = layer + "." + frame;
-    const TensorId q = like(at + ".q", kFeatureChannels, source), k = like(at + ".k", kFeatureChannels, source),
-                   v = like(at + ".v", kFeatureChannels, source);
-    linear(w.q_proj, layer + ".q_proj", all(source), all(q));  // already scaled by 1/sqrt(192)
-    linear(w.k_proj, layer + ".k_proj", all(target), all(k));
-    linear(w.v_proj, layer + ".v_proj", all(target), all(v));
-    const TensorId message = like(at + ".message", kFeatureChannels, source);
-    emit(Attention{all(q), all(k), all(v), all(message), scores(), block_rows_});
-    const TensorId merged = like(at + ".merge", kFeatureChannels, source);
-    linear(w.merge, layer + ".merge", all(message), all(merged));
-    // The MLP's input is concat[source, LayerNorm1(merged)].
-    const TensorId mlp_in = like(at + ".mlp_input", 2 * kFeatureChannels, source);
-    emit(LayerNorm<T>{&w.norm1, layer + ".norm1", all(merged), all(mlp_in).channels(kFeatureChannels, kFeatureChannels),
-                      std::nullopt});
-    emit(Copy{all(source), all(mlp_in).channels(0, kFeatureChannels)});
-    const TensorId hidden = like(at + ".mlp.0", 2 * kFeatureChannels, source);
-    linear(w.mlp0, layer + ".mlp.0", all(mlp_in), all(hidden), Activation::gelu);
-    const TensorId mlp_out = like(at + ".mlp.2", kFeatureChannels, source);
-    linear(w.mlp2, layer + ".mlp.2", all(hidden), all(mlp_out));
-    emit(LayerNorm<T>{&w.norm2, layer + ".norm2", all(mlp_out), all(out), all(source)});
+  // One cross-attention layer for both frames: each frame's tokens attend to the other's. Each
+  // frame's tokens are projected once into q, k and v (qkv_proj, q already scaled by
+  // 1/sqrt(192)): its own queries and the other frame's keys and values.
+  void attention_layer(const BasicAttentionLayerWeights<T>& w, const std::string& layer,
+                       std::array<TensorId, 2> sources, std::array<TensorId, 2> outs) {
+    std::array<TensorId, 2> qkv{};
+    for (std::size_t f = 0; f < 2; ++f) {
+      qkv[f] = like(layer + ".frame" + std::to_string(f) + ".qkv", 3 * kFeatureChannels, sources[f]);
+      linear(w.qkv_proj, layer + ".qkv_proj", all(sources[f]), all(qkv[f]));
+    }
+    for (std::size_t f = 0; f < 2; ++f) {
+      const std::string at = layer + ".frame" + std::to_string(f);
+      const TensorId source = sources[f], other = qkv[1 - f];
+      const TensorId message = like(at + ".message", kFeatureChannels, source);
+      emit(Attention{all(qkv[f]).channels(0, kFeatureChannels), all(other).channels(kFeatureChannels, kFeatureChannels),
+                     all(other).channels(2 * kFeatureChannels, kFeatureChannels), all(message), scores(), block_rows_});
+      const TensorId merged = like(at + ".merge", kFeatureChannels, source);
+      linear(w.merge, layer + ".merge", all(message), all(merged));
+      // The MLP's input is concat[source, LayerNorm1(merged)].
+      const TensorId mlp_in = like(at + ".mlp_input", 2 * kFeatureChannels, source);
+      emit(LayerNorm<T>{&w.norm1, layer + ".norm1", all(merged),
+                        all(mlp_in).channels(kFeatureChannels, kFeatureChannels), std::nullopt});
+      emit(Copy{all(source), all(mlp_in).channels(0, kFeatureChannels)});
+      const TensorId hidden = like(at + ".mlp.0", 2 * kFeatureChannels, source);
+      linear(w.mlp0, layer + ".mlp.0", all(mlp_in), all(hidden), Activation::gelu);
+      const TensorId mlp_out = like(at + ".mlp.2", kFeatureChannels, source);
+      linear(w.mlp2, layer + ".mlp.2", all(hidden), all(mlp_out));
+      emit(LayerNorm<T>{&w.norm2, layer + ".norm2", all(mlp_out), all(outs[f]), all(source)});
+    }
   }
 
   // `iterations` refinement steps of `flow` at its scale, from the pair's features and the
@@ -219,10 +225,8 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   const TensorId state1 = b.tensor("cross_attn_s16.layers.0.frame1", kFeatureChannels, h16, w16);
   const TensorId att0 = b.tensor("cross_attn_s16.frame0", kFeatureChannels, h16, w16);
   const TensorId att1 = b.tensor("cross_attn_s16.frame1", kFeatureChannels, h16, w16);
-  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", "frame0", first.f16, second.f16, state0);
-  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", "frame1", second.f16, first.f16, state1);
-  b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", "frame0", state0, state1, att0);
-  b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", "frame1", state1, state0, att1);
+  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", {first.f16, second.f16}, {state0, state1});
+  b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", {state0, state1}, {att0, att1});
   for (const TensorId a : {att0, att1}) {
     b.emit(ChannelAffine<T>{&w.attention_norm_scale, &w.attention_norm_shift, "cross_attn_s16.norm", b.all(a)});
   }

@@ -2,7 +2,10 @@
 // tensors it connects and matching the architecture table. A mistake in network_graph.cpp shows
 // up here, named, before any backend records or runs it.
 #include <stdexcept>
+#include <string>
+#include <string_view>
 #include <type_traits>
+#include <vector>
 
 #include "graph/network_graph.hpp"
 #include "network_dims.hpp"
@@ -84,9 +87,20 @@ class Checker {
   void check_op(const Linear<T>& o) {
     require(o.in.c == o.weights->in_features && o.out.c == o.weights->out_features && same_plane(o.in, o.out),
             "weights that do not fit its tensors");
-    const LayerSpec& spec = neuflow_v2_layer(o.layer);
-    require(spec.kind == LayerKind::linear && spec.in == o.in.c && spec.out == o.out.c,
-            "weights unlike the architecture table's layer");
+    // An attention layer's qkv_proj is the table's q_proj, k_proj and v_proj stacked.
+    const std::string_view stacked = ".qkv_proj";
+    std::vector<std::string> layers{o.layer};
+    if (o.layer.ends_with(stacked)) {
+      const std::string prefix = o.layer.substr(0, o.layer.size() - stacked.size());
+      layers = {prefix + ".q_proj", prefix + ".k_proj", prefix + ".v_proj"};
+    }
+    int out = 0;
+    for (const std::string& layer : layers) {
+      const LayerSpec& spec = neuflow_v2_layer(layer);  // std::out_of_range for a name the table lacks
+      require(spec.kind == LayerKind::linear && spec.in == o.in.c, "weights unlike the architecture table's layer");
+      out += spec.out;
+    }
+    require(out == o.out.c, "weights unlike the architecture table's layer");
   }
   void check_op(const LayerNorm<T>& o) {
     require(o.in.c == o.out.c && same_plane(o.in, o.out), "an output shaped unlike its input");
