@@ -7,9 +7,9 @@ namespace {
 
 // F(4×4, 3×3) in one dispatch (winograd_conv.comp): the filters and tiles transformed as they
 // are loaded, the products transformed back with bias, addend and activation as they are
-// stored. It reads what the direct convolution reads and writes what it writes.
+// stored. It reads what the direct convolution reads (`read` values) and writes what it writes.
 void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
-                           const View& addend) {
+                           const View& addend, long long read) {
   const DeviceConv& w = *op.weights;
   const int tiles_x = winograd_tiles(out.w), tile_count = tiles_x * winograd_tiles(out.h);
   const WinogradConvParams p{in.c,
@@ -24,8 +24,7 @@ void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, c
                              w.bias.offset,
                              op.addend ? addend.offset() : -1,
                              activation_code(op.act)};
-  const long long taps = 9LL * out.c * in.c, points = 36LL * out.c * in.c;
-  const long long read = in.count() + taps + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
+  const long long points = 36LL * out.c * in.c;
   r.dispatch<Shader::winograd_conv>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
                                     {r.bytes(read), r.bytes(out.count()), points * tile_count},
                                     tiles(tile_count, "a convolution", 32), tiles(out.c, "a convolution", 16));
@@ -68,18 +67,20 @@ void record_winograd(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const V
 
 }  // namespace
 
-// Stride-1 3×3 convolutions by Winograd where their filters were transformed at upload; the
-// rest by the implicit-GEMM convolution (matmul.comp with IMPLICIT_CONV): one 64×64 tile of
+// Stride-1 3×3 convolutions by Winograd where takes_winograd() says so, fused or split as the
+// network runs them; the rest by the implicit-GEMM convolution (matmul.comp with IMPLICIT_CONV): one 64×64 tile of
 // (pixels × output channels) per workgroup.
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
   const DeviceConv& w = *op.weights;
   const View in = r.view(op.in), out = r.view(op.out);
   const View addend = op.addend ? r.view(*op.addend) : View{};
+  const long long taps = static_cast<long long>(in.c) * w.kernel_h * w.kernel_w;
+  const long long read = in.count() + taps * out.c + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
   if (takes_winograd(r.conv_algorithm(), op, out.h, out.w)) {
     if (r.conv_algorithm() == ConvAlgorithm::winograd_split) {
       record_winograd(r, op, in, out, addend);
     } else {
-      record_winograd_fused(r, op, in, out, addend);
+      record_winograd_fused(r, op, in, out, addend, read);
     }
     return;
   }
@@ -99,8 +100,6 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
                        w.bias.offset,
                        op.addend ? addend.offset() : -1,
                        1.f};
-  const long long taps = static_cast<long long>(in.c) * w.kernel_h * w.kernel_w;
-  const long long read = in.count() + taps * out.c + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
   r.product<Shader::conv2d>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
                             {r.bytes(read), r.bytes(out.count()), taps * out.count()},
                             tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));

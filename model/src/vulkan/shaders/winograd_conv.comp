@@ -22,7 +22,9 @@ layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 #include "params/winograd_conv_params.h"
 #include "activate.glsl"
-#include "winograd_transforms.glsl"
+#define READS_INPUT_TILES
+#define WRITES_OUTPUT_TILES
+#include "winograd_tile_io.glsl"
 
 const int TILES = 32, CHANNELS = 16, STEP = 4;
 const int FILTERS = 36 * STEP * TILES;  // where the staged filters start
@@ -30,32 +32,13 @@ const int FILTERS = 36 * STEP * TILES;  // where the staged filters start
 // transformed by A: [CHANNELS][16 tiles][6 rows][4].
 shared float staged[36 * STEP * (TILES + CHANNELS)];
 
-// Transforms channel `ci` of tile `t` (zeros past the input, and for tiles and channels past
-// the last) into the staged tiles at step channel k, slot `slot`.
+// Transforms channel `ci` of tile `t` (zeros for tiles and channels past the last) into the
+// staged tiles at step channel k, slot `slot`.
 void stage_tile(int ci, int t, int k, int slot) {
-  float d[6][6];
-  const bool inside = ci < p.in_c && t < p.tiles;
   const int ty = t / p.tiles_x, tx = t - ty * p.tiles_x;
-  const int y0 = 4 * ty - 1, x0 = 4 * tx - 1;
-  const int base = p.in_off + ci * p.h * p.w;
-  for (int r = 0; r < 6; ++r) {
-    const int y = y0 + r;
-    for (int c = 0; c < 6; ++c) {
-      const int x = x0 + c;
-      d[r][c] = (inside && y >= 0 && y < p.h && x >= 0 && x < p.w) ? float(src[base + y * p.w + x]) : 0.0;
-    }
-  }
-  float cols[6][6];  // Bᵀ d
-  for (int c = 0; c < 6; ++c) {
-    float r[6];
-    input_1d(d[0][c], d[1][c], d[2][c], d[3][c], d[4][c], d[5][c], r);
-    for (int i = 0; i < 6; ++i) cols[i][c] = r[i];
-  }
-  for (int i = 0; i < 6; ++i) {  // (Bᵀ d) B
-    float r[6];
-    input_1d(cols[i][0], cols[i][1], cols[i][2], cols[i][3], cols[i][4], cols[i][5], r);
-    for (int j = 0; j < 6; ++j) staged[((6 * i + j) * STEP + k) * TILES + slot] = r[j];
-  }
+  float v[36];
+  input_tile(p.in_off + ci * p.h * p.w, ty, tx, ci < p.in_c && t < p.tiles, v);
+  for (int i = 0; i < 36; ++i) staged[(i * STEP + k) * TILES + slot] = v[i];
 }
 
 // G g Gᵀ of the filter from step channel k (c0 + k) to output channel o (o0 + o), pair
@@ -80,28 +63,13 @@ void stage_filter(int o0, int c0, int pair) {
   }
 }
 
-// Aᵀ of output channel `co`, tile `t`, from its 6 rows transformed by A (at `at` in staged),
-// then bias, addend and activation.
+// Output channel `co`, tile `t`, from its 6 rows transformed by A (at `at` in staged).
 void store_tile(int co, int t, int at) {
   if (co >= p.out_c || t >= p.tiles) return;
-  const int ty = t / p.tiles_x, tx = t - ty * p.tiles_x;
-  const float bias = p.bias_off >= 0 ? float(u[p.bias_off + co]) : 0.0;
-  const int plane = p.h * p.w;
-  for (int j = 0; j < 4; ++j) {
-    float o[4];
-    output_1d(staged[at + j], staged[at + 4 + j], staged[at + 8 + j], staged[at + 12 + j], staged[at + 16 + j],
-              staged[at + 20 + j], o);
-    const int x = 4 * tx + j;
-    if (x >= p.w) continue;
-    for (int r = 0; r < 4; ++r) {
-      const int y = 4 * ty + r;
-      if (y >= p.h) continue;
-      const int i = co * plane + y * p.w + x;
-      float v = o[r] + bias;
-      if (p.add_off >= 0) v += float(addend[p.add_off + i]);
-      dst[p.out_off + i] = VALUE(activate(v, p.act));
-    }
-  }
+  float rows[6][4];
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 4; ++j) rows[i][j] = staged[at + 4 * i + j];
+  store_output_tile(co, t / p.tiles_x, t % p.tiles_x, rows, p.bias_off >= 0 ? float(u[p.bias_off + co]) : 0.0);
 }
 
 void main() {

@@ -11,10 +11,10 @@ layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 #include "params/winograd_output_params.h"
 #include "activate.glsl"
 
-#include "winograd_transforms.glsl"
+#define WRITES_OUTPUT_TILES
+#include "winograd_tile_io.glsl"
 
 void main() {
-  const int plane = p.h * p.w;
   const int stride = p.c * p.tiles;  // between points
   FOR_EACH(i, p.c * p.tiles) {
     const int co = i / p.tiles, t = i - co * p.tiles;
@@ -26,20 +26,6 @@ void main() {
                 m[(6 * k + 3) * stride + i], m[(6 * k + 4) * stride + i], m[(6 * k + 5) * stride + i], o);
       for (int j = 0; j < 4; ++j) rows[k][j] = o[j];
     }
-    const float bias = p.bias_off >= 0 ? float(w[p.bias_off + co]) : 0.0;
-    for (int j = 0; j < 4; ++j) {  // Aᵀ (m A): each column
-      float o[4];
-      output_1d(rows[0][j], rows[1][j], rows[2][j], rows[3][j], rows[4][j], rows[5][j], o);
-      const int x = 4 * tx + j;
-      if (x >= p.w) continue;
-      for (int r = 0; r < 4; ++r) {
-        const int y = 4 * ty + r;
-        if (y >= p.h) continue;
-        const int at = co * plane + y * p.w + x;
-        float v = o[r] + bias;
-        if (p.add_off >= 0) v += float(addend[p.add_off + at]);
-        dst[p.out_off + at] = VALUE(activate(v, p.act));
-      }
-    }
+    store_output_tile(co, ty, tx, rows, p.bias_off >= 0 ? float(w[p.bias_off + co]) : 0.0);
   }
 }

@@ -1,0 +1,54 @@
+// F(4×4, 3×3)'s tiles read from and written to the planar tensors, shared by the split shaders
+// and the fused one. The including shader defines which it uses and declares what they touch:
+// READS_INPUT_TILES for input_tile, which reads `src` (p.h × p.w planes); WRITES_OUTPUT_TILES
+// for store_output_tile, which writes `dst` and reads `addend` (p.out_off, p.add_off, p.act).
+#include "winograd_transforms.glsl"
+
+#ifdef READS_INPUT_TILES
+// Bᵀ d B of the 6×6 input tile d around 4×4 output tile (ty, tx) of the plane at `base`: zeros
+// outside the input (padding 1), and everywhere where !inside. Point 6 i + j in v[6 i + j].
+void input_tile(int base, int ty, int tx, bool inside, out float v[36]) {
+  const int y0 = 4 * ty - 1, x0 = 4 * tx - 1;
+  float d[6][6];
+  for (int r = 0; r < 6; ++r) {
+    const int y = y0 + r;
+    for (int c = 0; c < 6; ++c) {
+      const int x = x0 + c;
+      d[r][c] = (inside && y >= 0 && y < p.h && x >= 0 && x < p.w) ? float(src[base + y * p.w + x]) : 0.0;
+    }
+  }
+  float cols[6][6];  // Bᵀ d: each column transformed
+  for (int c = 0; c < 6; ++c) {
+    float r[6];
+    input_1d(d[0][c], d[1][c], d[2][c], d[3][c], d[4][c], d[5][c], r);
+    for (int i = 0; i < 6; ++i) cols[i][c] = r[i];
+  }
+  for (int i = 0; i < 6; ++i) {  // (Bᵀ d) B: each row
+    float r[6];
+    input_1d(cols[i][0], cols[i][1], cols[i][2], cols[i][3], cols[i][4], cols[i][5], r);
+    for (int j = 0; j < 6; ++j) v[6 * i + j] = r[j];
+  }
+}
+#endif
+
+#ifdef WRITES_OUTPUT_TILES
+// Aᵀ (m A) of output channel `co`, tile (ty, tx), from its products' rows already times A,
+// then bias, addend and activation, as the direct convolution applies them.
+void store_output_tile(int co, int ty, int tx, float rows[6][4], float bias) {
+  const int plane = p.h * p.w;
+  for (int j = 0; j < 4; ++j) {  // each column
+    float o[4];
+    output_1d(rows[0][j], rows[1][j], rows[2][j], rows[3][j], rows[4][j], rows[5][j], o);
+    const int x = 4 * tx + j;
+    if (x >= p.w) continue;
+    for (int r = 0; r < 4; ++r) {
+      const int y = 4 * ty + r;
+      if (y >= p.h) continue;
+      const int at = co * plane + y * p.w + x;
+      float v = o[r] + bias;
+      if (p.add_off >= 0) v += float(addend[p.add_off + at]);
+      dst[p.out_off + at] = VALUE(activate(v, p.act));
+    }
+  }
+}
+#endif
