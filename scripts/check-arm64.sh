@@ -107,12 +107,39 @@ if ! "$probe"; then
 fi
 
 # --- build ----------------------------------------------------------------------------------
+# The arm64 package's library dependencies: a cross build has no arm64 package database for
+# dpkg-shlibdeps, so they are the native package's (the same Debian release; made here from
+# build/release when it is not there yet). Without a native build no arm64 package is made.
+native_deb=$(ls build/release/packages/neuflow_*_amd64.deb 2>/dev/null | head -1 || true)
+if [ -z "$native_deb" ] && [ -f build/release/CPackConfig.cmake ]; then
+  bash scripts/check-deb.sh --packages-only build/release
+  native_deb=$(ls build/release/packages/neuflow_*_amd64.deb | head -1)
+fi
+shlib_depends=""
+if [ -n "$native_deb" ]; then
+  # Without the entries the packaging adds itself (GStreamer's element packages).
+  shlib_depends=$(dpkg-deb -f "$native_deb" Depends | tr ',' '\n' | sed 's/^ *//' |
+                  grep -v '^gstreamer1.0-plugins-' | paste -sd, | sed 's/,/, /g')
+fi
+# The benchmarks are not run under emulation: not built either.
 cmake -S . -B "$build" -G Ninja --toolchain "$(pwd)/cmake/aarch64-linux-gnu.cmake" \
-  -DNEUFLOW_ARM64_SYSROOT="$sysroot" -DCMAKE_BUILD_TYPE=Release -DNEUFLOW_WERROR=ON >/dev/null
+  -DNEUFLOW_ARM64_SYSROOT="$sysroot" -DCMAKE_BUILD_TYPE=Release -DNEUFLOW_WERROR=ON \
+  -DNEUFLOW_BUILD_BENCHMARKS=OFF -DNEUFLOW_DEB_SHLIB_DEPENDS="$shlib_depends" >/dev/null
 start=$(date +%s)
 cmake --build "$build"
 say "every target built for aarch64 ($(( $(date +%s) - start )) s)"
 file "$build/tools/neuflow" | grep -q "ARM aarch64" || { say "tools/neuflow is not an aarch64 program" >&2; exit 1; }
+if [ -n "$shlib_depends" ]; then
+  rm -rf "$build/packages"
+  (cd "$build" && cpack -G DEB > cpack.log) || { cat "$build/cpack.log"; exit 1; }
+  arm64_deb=$(ls "$build"/packages/neuflow_*_arm64.deb)
+  dpkg-deb -x "$arm64_deb" "$work/deb-contents"
+  file "$work/deb-contents/usr/bin/neuflowd" | grep -q "ARM aarch64" || { say "$arm64_deb holds no aarch64 neuflowd" >&2; exit 1; }
+  rm -rf "$work/deb-contents"
+  say "the arm64 packages: $(cd "$build/packages" && ls ./*.deb | tr '\n' ' ')(in $build/packages; not installed here)"
+else
+  say "no arm64 package: no native package (build/release) to take its library dependencies from"
+fi
 
 # --- tests under emulation ------------------------------------------------------------------
 # The flow library, the model (its stages against the reference tensors, on the fixture's
