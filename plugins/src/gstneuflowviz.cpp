@@ -21,9 +21,13 @@
  * overlay mode, and are drawn as zero flow (white) in flow mode, as `neuflow convert` renders
  * them.
  *
+ * It draws on packed RGB frames in place, and takes every other format `neuflow` passes
+ * through (GRAY8, I420, NV12, YUY2) as well: those are converted to RGB first, so no
+ * `videoconvert` is needed between the two.
+ *
  * ## Example launch line
  * |[
- * gst-launch-1.0 v4l2src ! videoconvert ! neuflow ! videoconvert ! neuflowviz max-flow=30 alpha=0.6 arrows=true ! videoconvert ! autovideosink
+ * gst-launch-1.0 v4l2src ! videoconvert ! neuflow ! neuflowviz max-flow=30 alpha=0.6 arrows=true ! videoconvert ! autovideosink
  * ]|
  */
 #include <gst/gst.h>
@@ -46,6 +50,7 @@
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/flow/visualize.hpp"
 #include "neuflow/gst/flow_meta.h"
+#include "viz_formats.hpp"
 
 GST_DEBUG_CATEGORY_STATIC(gst_neuflow_viz_debug);
 #define GST_CAT_DEFAULT gst_neuflow_viz_debug
@@ -143,6 +148,8 @@ struct GstNeuflowViz {
   // Streaming thread only.
   PixelLayout layout;
   VizScratch *scratch;
+  // From the negotiated input format to the drawn one; null when the frames are drawn on in place.
+  GstVideoConverter *converter;
 };
 
 struct GstNeuflowVizClass {
@@ -155,12 +162,11 @@ G_DEFINE_TYPE_WITH_CODE(GstNeuflowViz, gst_neuflow_viz, GST_TYPE_VIDEO_FILTER,
                         GST_DEBUG_CATEGORY_INIT(gst_neuflow_viz_debug, "neuflowviz", 0,
                                                 "NeuFlow optical flow visualization"))
 
-#define VIZ_FORMATS "{ RGB, BGR, RGBx, BGRx, xRGB, xBGR, RGBA, BGRA, ARGB, ABGR }"
-
-static GstStaticPadTemplate sink_template =
-    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(VIZ_FORMATS)));
-static GstStaticPadTemplate src_template =
-    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE(VIZ_FORMATS)));
+static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
+    "sink", GST_PAD_SINK, GST_PAD_ALWAYS,
+    GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ " NEUFLOW_VIZ_DRAW_FORMATS ", " NEUFLOW_VIZ_CONVERTED_FORMATS " }")));
+static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
+    "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ " NEUFLOW_VIZ_DRAW_FORMATS " }")));
 
 namespace {
 
@@ -361,23 +367,48 @@ static void gst_neuflow_viz_finalize(GObject *object) {
   GstNeuflowViz *self = GST_NEUFLOW_VIZ(object);
   delete self->scratch;
   self->scratch = nullptr;
+  if (self->converter != nullptr) gst_video_converter_free(self->converter);
+  self->converter = nullptr;
   G_OBJECT_CLASS(gst_neuflow_viz_parent_class)->finalize(object);
 }
 
-// The per-format choice: where R, G and B are in a pixel of the negotiated format.
+static GstCaps *gst_neuflow_viz_transform_caps(GstBaseTransform *trans, GstPadDirection direction, GstCaps *caps,
+                                               GstCaps *filter) {
+  GstPad *other = direction == GST_PAD_SINK ? GST_BASE_TRANSFORM_SRC_PAD(trans) : GST_BASE_TRANSFORM_SINK_PAD(trans);
+  GstCaps *other_template = gst_pad_get_pad_template_caps(other);
+  GstCaps *result = neuflow::gst::viz_transform_caps(direction, caps, filter, other_template);
+  gst_caps_unref(other_template);
+  GST_DEBUG_OBJECT(trans, "%" GST_PTR_FORMAT " -> %" GST_PTR_FORMAT, static_cast<void *>(caps),
+                   static_cast<void *>(result));
+  return result;
+}
+
+// The per-format choice: where R, G and B are in a pixel of the drawn format, and whether the
+// frames are converted to it first.
 static gboolean gst_neuflow_viz_set_info(GstVideoFilter *filter, GstCaps * /*incaps*/, GstVideoInfo *in_info,
-                                         GstCaps * /*outcaps*/, GstVideoInfo * /*out_info*/) {
+                                         GstCaps * /*outcaps*/, GstVideoInfo *out_info) {
   GstNeuflowViz *self = GST_NEUFLOW_VIZ(filter);
-  const GstVideoFormatInfo *finfo = in_info->finfo;
+  if (self->converter != nullptr) gst_video_converter_free(self->converter);
+  self->converter = nullptr;
+  const bool convert = GST_VIDEO_INFO_FORMAT(in_info) != GST_VIDEO_INFO_FORMAT(out_info);
+  if (convert) {
+    self->converter = gst_video_converter_new(in_info, out_info, nullptr);
+    if (self->converter == nullptr) {
+      GST_ERROR_OBJECT(self, "cannot convert %s to %s", GST_VIDEO_INFO_NAME(in_info), GST_VIDEO_INFO_NAME(out_info));
+      return FALSE;
+    }
+  }
+  gst_base_transform_set_in_place(GST_BASE_TRANSFORM(filter), !convert);
+  const GstVideoFormatInfo *finfo = out_info->finfo;
   if (!GST_VIDEO_FORMAT_INFO_IS_RGB(finfo) || GST_VIDEO_FORMAT_INFO_N_PLANES(finfo) != 1 ||
       GST_VIDEO_FORMAT_INFO_BITS(finfo) != 8) {
     GST_ERROR_OBJECT(self, "unsupported format %s", GST_VIDEO_FORMAT_INFO_NAME(finfo));
     return FALSE;
   }
-  self->layout.r = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_R));
-  self->layout.g = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_G));
-  self->layout.b = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(in_info, GST_VIDEO_COMP_B));
-  self->layout.stride = GST_VIDEO_INFO_COMP_PSTRIDE(in_info, 0);
+  self->layout.r = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(out_info, GST_VIDEO_COMP_R));
+  self->layout.g = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(out_info, GST_VIDEO_COMP_G));
+  self->layout.b = static_cast<int>(GST_VIDEO_INFO_COMP_POFFSET(out_info, GST_VIDEO_COMP_B));
+  self->layout.stride = GST_VIDEO_INFO_COMP_PSTRIDE(out_info, 0);
   if (self->layout.stride == 3) {
     self->layout.replace = compose_flow<3, true>;
     self->layout.overlay = compose_flow<3, false>;
@@ -388,8 +419,9 @@ static gboolean gst_neuflow_viz_set_info(GstVideoFilter *filter, GstCaps * /*inc
     GST_ERROR_OBJECT(self, "unsupported pixel size %d in %s", self->layout.stride, GST_VIDEO_FORMAT_INFO_NAME(finfo));
     return FALSE;
   }
-  GST_DEBUG_OBJECT(self, "format %s: R at %d, G at %d, B at %d, %d bytes per pixel", GST_VIDEO_FORMAT_INFO_NAME(finfo),
-                   self->layout.r, self->layout.g, self->layout.b, self->layout.stride);
+  GST_DEBUG_OBJECT(self, "%s%s: R at %d, G at %d, B at %d, %d bytes per pixel", convert ? "converted to " : "format ",
+                   GST_VIDEO_FORMAT_INFO_NAME(finfo), self->layout.r, self->layout.g, self->layout.b,
+                   self->layout.stride);
   return TRUE;
 }
 
@@ -401,7 +433,8 @@ static void gst_neuflow_viz_before_transform(GstBaseTransform *trans, GstBuffer 
   GST_OBJECT_LOCK(self);
   const bool flow_mode = self->settings.mode == GST_NEUFLOW_VIZ_MODE_FLOW;
   GST_OBJECT_UNLOCK(self);
-  const bool draw = flow_mode || neuflow_buffer_get_flow_meta(buffer) != nullptr;
+  // A converted frame is always a new buffer.
+  const bool draw = flow_mode || self->converter != nullptr || neuflow_buffer_get_flow_meta(buffer) != nullptr;
   if ((gst_base_transform_is_passthrough(trans) != FALSE) == draw) {
     GST_LOG_OBJECT(trans, "%s", draw ? "drawing" : "no flow meta: passing through");
     gst_base_transform_set_passthrough(trans, !draw);
@@ -418,9 +451,7 @@ static void fill_zero_flow(GstVideoFrame *frame, const PixelLayout &px) {
   }
 }
 
-static GstFlowReturn gst_neuflow_viz_transform_frame_ip(GstVideoFilter *filter, GstVideoFrame *frame) {
-  GstNeuflowViz *self = GST_NEUFLOW_VIZ(filter);
-  NeuflowFlowMeta *meta = neuflow_buffer_get_flow_meta(frame->buffer);
+static GstFlowReturn draw_flow(GstNeuflowViz *self, GstVideoFrame *frame, NeuflowFlowMeta *meta) {
   GST_OBJECT_LOCK(self);
   const VizSettings settings = self->settings;
   GST_OBJECT_UNLOCK(self);
@@ -476,6 +507,25 @@ static GstFlowReturn gst_neuflow_viz_transform_frame_ip(GstVideoFilter *filter, 
     return GST_FLOW_ERROR;
   }
   return GST_FLOW_OK;
+}
+
+static GstFlowReturn gst_neuflow_viz_transform_frame_ip(GstVideoFilter *filter, GstVideoFrame *frame) {
+  return draw_flow(GST_NEUFLOW_VIZ(filter), frame, neuflow_buffer_get_flow_meta(frame->buffer));
+}
+
+static GstFlowReturn gst_neuflow_viz_transform_frame(GstVideoFilter *filter, GstVideoFrame *in_frame,
+                                                     GstVideoFrame *out_frame) {
+  GstNeuflowViz *self = GST_NEUFLOW_VIZ(filter);
+  gst_video_converter_frame(self->converter, in_frame, out_frame);
+  return draw_flow(self, out_frame, neuflow_buffer_get_flow_meta(in_frame->buffer));
+}
+
+// The flow belongs to the frame whatever its colour format: a converted frame keeps it for
+// the elements after this one (neuflowsink, neuflowshmsink).
+static gboolean gst_neuflow_viz_transform_meta(GstBaseTransform *trans, GstBuffer *outbuf, GstMeta *meta,
+                                               GstBuffer *inbuf) {
+  if (meta->info->api == NEUFLOW_FLOW_META_API_TYPE) return TRUE;
+  return GST_BASE_TRANSFORM_CLASS(gst_neuflow_viz_parent_class)->transform_meta(trans, outbuf, meta, inbuf);
 }
 
 static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
@@ -541,10 +591,13 @@ static void gst_neuflow_viz_class_init(GstNeuflowVizClass *klass) {
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
 
+  trans_class->transform_caps = GST_DEBUG_FUNCPTR(gst_neuflow_viz_transform_caps);
   trans_class->before_transform = GST_DEBUG_FUNCPTR(gst_neuflow_viz_before_transform);
   trans_class->transform_ip_on_passthrough = FALSE;
+  trans_class->transform_meta = GST_DEBUG_FUNCPTR(gst_neuflow_viz_transform_meta);
   filter_class->set_info = GST_DEBUG_FUNCPTR(gst_neuflow_viz_set_info);
   filter_class->transform_frame_ip = GST_DEBUG_FUNCPTR(gst_neuflow_viz_transform_frame_ip);
+  filter_class->transform_frame = GST_DEBUG_FUNCPTR(gst_neuflow_viz_transform_frame);
 
   gst_type_mark_as_plugin_api(GST_TYPE_NEUFLOW_VIZ_MODE, static_cast<GstPluginAPIFlags>(0));
 }
@@ -553,6 +606,7 @@ static void gst_neuflow_viz_init(GstNeuflowViz *self) {
   self->settings = VizSettings{};
   self->layout = PixelLayout{};
   self->scratch = new VizScratch();
+  self->converter = nullptr;
 }
 
 GST_ELEMENT_REGISTER_DEFINE(neuflowviz, "neuflowviz", GST_RANK_NONE, gst_neuflow_viz_get_type());

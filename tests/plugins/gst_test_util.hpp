@@ -30,11 +30,15 @@ struct ObjectDeleter {
 struct MessageDeleter {
   void operator()(GstMessage *m) const { gst_message_unref(m); }
 };
+struct CapsDeleter {
+  void operator()(GstCaps *c) const { gst_caps_unref(c); }
+};
 using HarnessPtr = std::unique_ptr<GstHarness, HarnessDeleter>;
 using BufferPtr = std::unique_ptr<GstBuffer, BufferDeleter>;
 using ElementPtr = std::unique_ptr<GstElement, ObjectDeleter>;
 using BusPtr = std::unique_ptr<GstBus, ObjectDeleter>;
 using MessagePtr = std::unique_ptr<GstMessage, MessageDeleter>;
+using CapsPtr = std::unique_ptr<GstCaps, CapsDeleter>;
 
 // Takes ownership of a new element (sinking its floating reference).
 inline ElementPtr owned(GstElement *element) {

@@ -217,6 +217,23 @@ TEST_F(NeuflowElement, EveryPairModeOnAFileComputesEveryPairAndDrainsAtEos) {
   gst_object_unref(pipeline);
 }
 
+// A camera's NV12 goes through neuflow and straight into neuflowviz, as the README's chains
+// have it: no videoconvert between them, every flow drawn and still on the drawn frames.
+TEST_F(NeuflowElement, Nv12ChainsIntoNeuflowvizWithoutVideoconvert) {
+  Counter counter;
+  GstElement* pipeline = pipeline_with_counter(
+      "videotestsrc num-buffers=4 pattern=ball ! video/x-raw,format=NV12,width=64,height=48 ! neuflow "
+      "iters-s8=1 threads=2 behaviour=every-pair model=" +
+          model_ + " ! neuflowviz name=nf mode=flow ! video/x-raw,format=RGB ! fakesink sync=false",
+      &counter);
+  ASSERT_NE(pipeline, nullptr);
+  EXPECT_EQ(run_to_end(pipeline, 120 * GST_SECOND), GST_MESSAGE_EOS);
+  EXPECT_EQ(counter.buffers, 4u);
+  EXPECT_EQ(counter.flows, 3u) << "flows counted after neuflowviz (the probe is on its src pad)";
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+}
+
 TEST_F(NeuflowElement, LiveSourceFasterThanInferenceDropsAndKeepsOrder) {
   Counter counter;
   // 120 fps of 320×240 against inference that takes tens of milliseconds per frame.

@@ -388,5 +388,68 @@ TEST(NeuflowViz, FlowMetaSurvivesVideoconvertInFront) {
   EXPECT_EQ(pixel_bytes(out.get(), GST_VIDEO_FORMAT_RGBA, w, h, 2, 2), (std::vector<std::uint8_t>{255, 0, 0, 255}));
 }
 
+// What `neuflow` passes through besides RGB (GRAY8, I420, NV12, YUY2) links straight to
+// neuflowviz: converted to RGB inside, drawn, and the flow meta still on the drawn frame.
+class NeuflowVizConverted : public ::testing::TestWithParam<GstVideoFormat> {};
+
+TEST_P(NeuflowVizConverted, IsConvertedToRgbAndDrawnWithItsMetaKept) {
+  constexpr int w = 8, h = 6;
+  const GstVideoFormat format = GetParam();
+  auto harness = make_viz(format, w, h);
+  BufferPtr out(gst_harness_push_and_pull(harness.get(), frame_with_uniform_flow(format, w, h, 128, w, h, 20, 0)));
+  ASSERT_TRUE(out);
+  CapsPtr caps(gst_pad_get_current_caps(harness->sinkpad));
+  ASSERT_TRUE(caps);
+  GstVideoInfo info;
+  ASSERT_TRUE(gst_video_info_from_caps(&info, caps.get()));
+  ASSERT_TRUE(GST_VIDEO_INFO_IS_RGB(&info)) << gst_video_format_to_string(GST_VIDEO_INFO_FORMAT(&info));
+  expect_uniform(out.get(), w, h, Rgb8{255, 0, 0});  // RGB: the first drawable format
+  EXPECT_NE(neuflow_buffer_get_flow_meta(out.get()), nullptr) << "the flow meta is lost on the converted frame";
+}
+
+TEST_P(NeuflowVizConverted, WithoutFlowInOverlayModeIsOnlyConverted) {
+  constexpr int w = 8, h = 6;
+  const GstVideoFormat format = GetParam();
+  auto harness = make_viz(format, w, h, "overlay");
+  BufferPtr out(gst_harness_push_and_pull(harness.get(), make_frame(format, w, h, 128)));
+  ASSERT_TRUE(out);
+  const Rgb8 got = rgb_at(out.get(), GST_VIDEO_FORMAT_RGB, w, h, 3, 3);
+  // Y = U = V = 128 (or grey 128): a mid grey, whatever the matrix.
+  for (const auto c : got) EXPECT_NEAR(c, 128, 12) << to_string(got);
+}
+
+INSTANTIATE_TEST_SUITE_P(NeuflowsOtherFormats, NeuflowVizConverted,
+                         ::testing::Values(GST_VIDEO_FORMAT_GRAY8, GST_VIDEO_FORMAT_I420, GST_VIDEO_FORMAT_NV12,
+                                           GST_VIDEO_FORMAT_YUY2),
+                         [](const ::testing::TestParamInfo<GstVideoFormat> &param) {
+                           return std::string(gst_video_format_to_string(param.param));
+                         });
+
+TEST(NeuflowViz, LinksAfterAYuvSourceWithoutVideoconvert) {
+  ElementPtr pipeline = owned(gst_parse_launch(
+      "videotestsrc num-buffers=3 ! video/x-raw,format=NV12,width=64,height=48 ! neuflowviz ! fakesink", nullptr));
+  ASSERT_TRUE(pipeline);
+  ASSERT_NE(gst_element_set_state(pipeline.get(), GST_STATE_PLAYING), GST_STATE_CHANGE_FAILURE);
+  BusPtr bus(gst_element_get_bus(pipeline.get()));
+  MessagePtr msg(gst_bus_timed_pop_filtered(bus.get(), 10 * GST_SECOND,
+                                            static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR)));
+  ASSERT_TRUE(msg);
+  EXPECT_EQ(GST_MESSAGE_TYPE(msg.get()), GST_MESSAGE_EOS);
+  gst_element_set_state(pipeline.get(), GST_STATE_NULL);
+}
+
+TEST(NeuflowViz, RgbFramesAreStillDrawnInPlace) {
+  constexpr int w = 8, h = 6;
+  auto harness = make_viz(GST_VIDEO_FORMAT_BGRx, w, h);
+  GstBuffer *in = frame_with_uniform_flow(GST_VIDEO_FORMAT_BGRx, w, h, 77, w, h, 20, 0);
+  BufferPtr out(gst_harness_push_and_pull(harness.get(), in));
+  ASSERT_TRUE(out);
+  EXPECT_EQ(out.get(), in) << "a writable RGB frame was copied instead of drawn on";
+  CapsPtr caps(gst_pad_get_current_caps(harness->sinkpad));
+  GstVideoInfo info;
+  ASSERT_TRUE(gst_video_info_from_caps(&info, caps.get()));
+  EXPECT_EQ(GST_VIDEO_INFO_FORMAT(&info), GST_VIDEO_FORMAT_BGRx);
+}
+
 }  // namespace
 }  // namespace neuflow::gst_test
