@@ -43,10 +43,8 @@
 #include <optional>
 #include <vector>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "elements.hpp"
+#include "neuflow/flow/arrows.hpp"
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/flow/visualize.hpp"
 #include "neuflow/gst/flow_meta.h"
@@ -132,10 +130,10 @@ struct PixelLayout {
 // frame pixels, and the bilinear sampling tables from frame columns to grid columns.
 struct VizScratch {
   neuflow::flow::FlowField field;
-  std::vector<int> x0, x1, wx;  // column -> grid columns and weight of x1 (0..256)
-  std::vector<int> y0, y1, wy;  // the same for rows
-  std::vector<int> row;         // one output row's blend of its two grid rows, RGB
-  cv::Mat arrow_mask;           // the arrows' anti-aliased coverage, 0..255
+  std::vector<int> x0, x1, wx;           // column -> grid columns and weight of x1 (0..256)
+  std::vector<int> y0, y1, wy;           // the same for rows
+  std::vector<int> row;                  // one output row's blend of its two grid rows, RGB
+  std::vector<std::uint8_t> arrow_mask;  // the arrows' anti-aliased coverage, 0..255
 };
 
 }  // namespace
@@ -243,80 +241,19 @@ void compose_flow(GstVideoFrame *frame, const PixelLayout &px, const neuflow::fl
   }
 }
 
-// Clips the segment to [0, width-1] × [0, height-1] (Liang–Barsky), so that absurd vectors cost
-// no more than the frame's diagonal and fit OpenCV's integer coordinates; false when nothing
-// of it is inside.
-bool clip_segment(double &xa, double &ya, double &xb, double &yb, int width, int height) {
-  const double dx = xb - xa, dy = yb - ya;
-  double t0 = 0, t1 = 1;
-  const double p[4] = {-dx, dx, -dy, dy};
-  const double q[4] = {xa, (width - 1) - xa, ya, (height - 1) - ya};
-  for (int i = 0; i < 4; ++i) {
-    if (p[i] == 0) {
-      if (q[i] < 0) return false;  // parallel to this edge and outside it
-      continue;
-    }
-    const double t = q[i] / p[i];
-    if (p[i] < 0) {
-      t0 = std::max(t0, t);
-    } else {
-      t1 = std::min(t1, t);
-    }
-    if (t0 > t1) return false;
-  }
-  xb = xa + t1 * dx;
-  yb = ya + t1 * dy;
-  xa = xa + t0 * dx;
-  ya = ya + t0 * dy;
-  return true;
-}
-
-// OpenCV's fixed-point coordinates: sub-pixel positions for anti-aliased lines.
-constexpr int kShift = 4;
-cv::Point fixed_point(double x, double y) {
-  return {static_cast<int>(std::lround(x * (1 << kShift))), static_cast<int>(std::lround(y * (1 << kShift)))};
-}
-
-// One anti-aliased arrow at the centre of each spacing × spacing cell, showing the vector of the
-// grid cell under it (nearest) in frame pixels times `scale`, at most `max_length` long,
-// blended in the colour 0xAARRGGBB.
+// The arrows of flow/arrows.hpp, blended in the colour 0xAARRGGBB.
 void draw_arrows(GstVideoFrame *frame, const PixelLayout &px, const neuflow::flow::FlowField &field, guint spacing,
-                 double scale, double max_length, guint argb, cv::Mat &mask) {
+                 double scale, double max_length, guint argb, std::vector<std::uint8_t> &mask) {
   const int fw = GST_VIDEO_FRAME_WIDTH(frame);
   const int fh = GST_VIDEO_FRAME_HEIGHT(frame);
-  const int step = static_cast<int>(spacing);
-  mask.create(fh, fw, CV_8UC1);
-  mask.setTo(0);
-  for (int y = step / 2; y < fh; y += step) {
-    const int gy = std::min(static_cast<int>((y + 0.5) * field.height / fh), field.height - 1);
-    for (int x = step / 2; x < fw; x += step) {
-      const int gx = std::min(static_cast<int>((x + 0.5) * field.width / fw), field.width - 1);
-      double u = scale * field.u(gx, gy), v = scale * field.v(gx, gy);
-      const double len = std::hypot(u, v);
-      if (!(len >= 1.0) || !std::isfinite(len)) {  // under a pixel (or not finite): just the anchor
-        mask.at<std::uint8_t>(y, x) = 255;
-        continue;
-      }
-      if (len > max_length) {
-        u *= max_length / len;
-        v *= max_length / len;
-      }
-      double xa = x, ya = y, xb = x + u, yb = y + v;
-      if (!clip_segment(xa, ya, xb, yb, fw, fh)) continue;
-      // The head: a fixed share of the drawn length, at least 2 px, at most 0.4 of the spacing.
-      const double drawn = std::hypot(xb - xa, yb - ya);
-      const double head = std::clamp(0.3 * drawn, 2.0, std::max(2.0, 0.4 * step));
-      cv::arrowedLine(mask, fixed_point(xa, ya), fixed_point(xb, yb), cv::Scalar(255), 1, cv::LINE_AA, kShift,
-                      drawn > 0 ? std::min(1.0, head / drawn) : 0.0);
-    }
-  }
+  neuflow::flow::arrow_coverage(field, fw, fh, static_cast<int>(spacing), scale, max_length, mask);
   const int a = static_cast<int>((argb >> 24) & 0xff);
   const int color[3] = {static_cast<int>((argb >> 16) & 0xff), static_cast<int>((argb >> 8) & 0xff),
                         static_cast<int>(argb & 0xff)};
   auto *data = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_PLANE_DATA(frame, 0));
   const int stride = GST_VIDEO_FRAME_PLANE_STRIDE(frame, 0);
   for (int y = 0; y < fh; ++y) {
-    const std::uint8_t *m = mask.ptr<std::uint8_t>(y);
+    const std::uint8_t *m = mask.data() + static_cast<std::ptrdiff_t>(y) * fw;
     std::uint8_t *p = data + static_cast<std::ptrdiff_t>(y) * stride;
     for (int x = 0; x < fw; ++x, p += px.stride) {
       if (m[x] == 0) continue;
@@ -496,11 +433,12 @@ static GstFlowReturn draw_flow(GstNeuflowViz *self, GstVideoFrame *frame, Neuflo
     if (settings.arrows) {
       // Auto scale: a vector of max-flow pixels (this frame's largest when max-flow is 0) is
       // one arrow-spacing long, and longer ones are drawn that long, so arrows stay in their cell.
-      const bool automatic = settings.arrow_scale <= 0;
-      const double spacing = settings.arrow_spacing;
-      const double scale = automatic ? spacing / std::max(vis.max_flow, 1e-6) : settings.arrow_scale;
-      draw_arrows(frame, self->layout, s.field, settings.arrow_spacing, scale,
-                  automatic ? spacing : std::numeric_limits<double>::infinity(), settings.arrow_color, s.arrow_mask);
+      const neuflow::flow::ArrowScale scale =
+          settings.arrow_scale <= 0
+              ? neuflow::flow::automatic_arrow_scale(static_cast<int>(settings.arrow_spacing), vis.max_flow)
+              : neuflow::flow::ArrowScale{settings.arrow_scale, std::numeric_limits<double>::infinity()};
+      draw_arrows(frame, self->layout, s.field, settings.arrow_spacing, scale.scale, scale.max_length,
+                  settings.arrow_color, s.arrow_mask);
     }
   } catch (const std::exception &e) {
     GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Could not draw the optical flow: %s", e.what()), (nullptr));

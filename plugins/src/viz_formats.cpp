@@ -9,8 +9,8 @@ namespace {
 // The "format" value (a list) of caps made of these formats.
 const GValue *format_list(bool with_converted) {
   static GstCaps *drawn = gst_caps_from_string(GST_VIDEO_CAPS_MAKE("{ " NEUFLOW_VIZ_DRAW_FORMATS " }"));
-  static GstCaps *all = gst_caps_from_string(
-      GST_VIDEO_CAPS_MAKE("{ " NEUFLOW_VIZ_DRAW_FORMATS ", " NEUFLOW_VIZ_CONVERTED_FORMATS " }"));
+  static GstCaps *all =
+      gst_caps_from_string(GST_VIDEO_CAPS_MAKE("{ " NEUFLOW_VIZ_DRAW_FORMATS ", " NEUFLOW_VIZ_CONVERTED_FORMATS " }"));
   return gst_structure_get_value(gst_caps_get_structure(with_converted ? all : drawn, 0), "format");
 }
 

@@ -1,11 +1,14 @@
-// `neuflow compare PRED GT [--json]`: accuracy of a predicted flow file against ground truth.
+// `neuflow compare PRED GT [--json] [--error-map FILE.png]`: accuracy of a predicted flow file
+// against ground truth, and where the error is.
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "commands.hpp"
+#include "common/png_name.hpp"
 #include "neuflow/flow/errors.hpp"
+#include "neuflow/flow/figures.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/flow/metrics.hpp"
 
@@ -18,6 +21,7 @@ struct CompareOptions {
   std::string ground_truth;
   bool json = false;
   bool use_predicted_mask = false;
+  std::string error_map;  // --error-map: empty for none
 };
 
 flow::FlowField read(const std::string& path) {
@@ -73,10 +77,22 @@ void run_compare(const CompareOptions& options) {
   flow::MetricsOptions metrics_options;
   metrics_options.use_predicted_mask = options.use_predicted_mask;
   const flow::FlowMetrics m = flow::compute_metrics(predicted, ground_truth, metrics_options);
+  if (!options.error_map.empty()) {
+    flow::RgbImage map = flow::error_map(predicted, ground_truth);
+    char label[64];
+    std::snprintf(label, sizeof label, std::isfinite(m.epe) ? "EPE %.3f px" : "EPE n/a", m.epe);
+    flow::draw_label(map, label);
+    try {
+      flow::write_rgb_png(map, options.error_map);
+    } catch (const flow::FlowFileError& e) {
+      throw CommandError(exit_code_for(e), std::string("compare: ") + e.what());
+    }
+  }
   if (options.json) {
     print_json(m);
   } else {
     print_text(m);
+    if (!options.error_map.empty()) std::printf("wrote %s\n", options.error_map.c_str());
   }
 }
 
@@ -96,6 +112,10 @@ void register_compare(CLI::App& app) {
   cmd->add_flag("--pred-mask", options->use_predicted_mask,
                 "Also skip pixels that are invalid in the prediction (default: score them as "
                 "they are)");
+  cmd->add_option("--error-map", options->error_map,
+                  "Also write the end-point error of every scored pixel as a PNG: a colour map (dark: none, "
+                  "yellow: the largest) with its scale bar, the EPE in the corner, unscored pixels black")
+      ->check(png_name);
   cmd->callback([options] { run_compare(*options); });
 }
 

@@ -35,6 +35,7 @@ struct ConvertArgs {
   // Words, mapped after parsing (CLI11 2.1 cannot print FlowFormat's default).
   std::string format = "flo";
   std::string viz = "none";
+  std::string viz_mode = "flow";
   double max_flow = 20;
   bool resume = false;
   bool overwrite = false;
@@ -189,6 +190,7 @@ void run_convert(const ConvertArgs& a) {
                     : a.format == "png" ? flow::FlowFormat::kitti_png
                                         : flow::FlowFormat::flo;
   settings.viz = a.viz == "png" ? VizMode::png : a.viz == "video" ? VizMode::video : VizMode::none;
+  settings.viz_look = a.viz_mode == "overlay" ? VizLook::overlay : VizLook::flow;
   settings.max_flow = a.max_flow;
   settings.resume = a.resume;
   settings.overwrite = a.overwrite;
@@ -263,6 +265,11 @@ void register_convert(CLI::App& app) {
                   "Colour rendering of each flow: png (viz/<frame>.png), video (viz.mp4, H.264, at the video's frame "
                   "rate; for images --fps, else the rate their timestamp names give, else 10 fps) or none")
       ->check(CLI::IsMember({"none", "png", "video"}))
+      ->capture_default_str();
+  sub->add_option("--viz-mode", args->viz_mode,
+                  "What --viz shows: flow (the colours alone) or overlay (blended over the pair's first frame at "
+                  "60 %, as the neuflowviz element's default)")
+      ->check(CLI::IsMember({"flow", "overlay"}))
       ->capture_default_str();
   sub->add_option("--max-flow", args->max_flow,
                   "Flow magnitude (px) drawn fully saturated in --viz; fixed so colours mean the same in every frame")

@@ -36,6 +36,8 @@ expect_stdout() { grep -Eq -- "$1" "$work/stdout" || fail "stdout does not match
 expect_stderr() { grep -Eq -- "$1" "$work/stderr" || fail "stderr does not match /$1/"; }
 
 is_png() { [[ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" == 89504e470d0a1a0a ]]; }
+# A PNG's width and height from its IHDR chunk: "WxH".
+png_size() { echo "$(( 0x$(od -An -tx1 -j16 -N4 "$1" | tr -d ' \n') ))x$(( 0x$(od -An -tx1 -j20 -N4 "$1" | tr -d ' \n') ))"; }
 
 case "$case_name" in
   viz)  # viz FIXTURE: renders it, per-image normalization and a fixed maximum
@@ -73,6 +75,38 @@ case "$case_name" in
     need_fixture "$2"
     run_expect 65 "$bin" compare "$gt/$1" "$gt/$2"
     expect_stderr "is [0-9]+x[0-9]+ but .* is [0-9]+x[0-9]+"
+    ;;
+  viz_pictures)  # viz_pictures FLOW IMAGE OTHER_IMAGE: --key, --arrows and --overlay, as the element draws them
+    need_fixture "$1"
+    need_fixture "$2"
+    need_fixture "$3"
+    run_expect 0 "$bin" viz "$gt/$1" -o "$work/plain.png" --max-flow 5
+    size=$(png_size "$work/plain.png")
+    for extra in "--key" "--arrows" "--arrows --arrow-spacing 12" "--overlay $gt/$2" "--overlay $gt/$2 --alpha 0.3 --key --arrows"; do
+      # shellcheck disable=SC2086  # the options are words
+      run_expect 0 "$bin" viz "$gt/$1" -o "$work/extra.png" --max-flow 5 $extra
+      [[ "$(png_size "$work/extra.png")" == "$size" ]] || fail "viz $extra: $(png_size "$work/extra.png"), not $size"
+      ! cmp -s "$work/plain.png" "$work/extra.png" || fail "viz $extra drew nothing more than the plain rendering"
+    done
+    run_expect 0 "$bin" viz "$gt/$1" -o "$work/opaque.png" --max-flow 5 --overlay "$gt/$2" --alpha 1
+    cmp -s "$work/plain.png" "$work/opaque.png" || fail "--alpha 1 is not the rendering alone"
+    run_expect 65 "$bin" viz "$gt/$1" -o "$work/bad.png" --overlay "$gt/$3"
+    expect_stderr "--overlay .* is [0-9]+x[0-9]+ but the flow is ${size}"
+    run_expect 66 "$bin" viz "$gt/$1" -o "$work/bad.png" --overlay "$work/none.png"
+    expect_stderr "cannot read it as an image"
+    [[ ! -e "$work/bad.png" ]] || fail "a picture was written for a bad --overlay"
+    ;;
+  compare_error_map)  # compare_error_map FLOW: the error map of a flow against itself and against zero
+    need_fixture "$1"
+    run_expect 0 "$bin" compare "$gt/$1" "$gt/$1" --error-map "$work/self.png"
+    is_png "$work/self.png" || fail "self.png is not a PNG"
+    expect_stdout "^wrote .*self\.png"
+    run_expect 0 "$bin" viz "$gt/$1" -o "$work/rendering.png"
+    [[ "$(png_size "$work/self.png")" == "$(png_size "$work/rendering.png")" ]] || fail "the map is not the flow's size"
+    run_expect 0 "$bin" compare --json "$gt/$1" "$gt/$1" --error-map "$work/json.png"
+    [[ "$(head -c 1 "$work/stdout")" == "{" && "$(wc -l < "$work/stdout")" -eq 1 ]] || fail "--json printed more than JSON"
+    run_expect 64 "$bin" compare "$gt/$1" "$gt/$1" --error-map "$work/map.jpg"
+    expect_stderr "give it a \.png name"
     ;;
   missing)  # a missing input: exit 66 (EX_NOINPUT) from both subcommands
     run_expect 66 "$bin" compare "$work/none.flo" "$work/none.flo"

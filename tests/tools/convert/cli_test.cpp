@@ -472,6 +472,32 @@ TEST_F(ConvertCli, KittiFlowsAndPngRenderings) {
   }
 }
 
+// --viz-mode overlay: each rendering blended over its pair's first frame at the element's 60 %
+// (weight 154 of 256), the same colours --viz-mode flow draws alone.
+TEST_F(ConvertCli, VizModeOverlayBlendsTheRenderingOverTheFirstFrame) {
+  TempDir dir;
+  const auto frames = make_frames(dir / "seq", {"a.png", "b.png"});
+  ASSERT_EQ(convert(dir / "flow", {(dir / "seq").string(), "--viz", "png"}).exit_code, 0);
+  const auto result = convert(dir / "over", {(dir / "seq").string(), "--viz", "png", "--viz-mode", "overlay"});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const cv::Mat alone = cv::imread((dir / "flow" / "seq" / "viz" / "a.png").string(), cv::IMREAD_COLOR);
+  const cv::Mat over = cv::imread((dir / "over" / "seq" / "viz" / "a.png").string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(alone.empty());
+  ASSERT_EQ(over.size(), frames[0].size());
+  int wrong = 0;
+  for (int y = 0; y < over.rows; ++y) {
+    for (int x = 0; x < over.cols; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const int expected =
+            (frames[0].at<cv::Vec3b>(y, x)[c] * (256 - 154) + alone.at<cv::Vec3b>(y, x)[c] * 154 + 128) >> 8;
+        wrong += over.at<cv::Vec3b>(y, x)[c] != expected ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_EQ(wrong, 0) << "channels that are not the 60 % blend of the frame and the flow's colours";
+  EXPECT_EQ(convert(dir / "bad", {(dir / "seq").string(), "--viz", "png", "--viz-mode", "arrows"}).exit_code, 64);
+}
+
 TEST_F(ConvertCli, BgrChannelOrderFeedsTheNetworkSwappedChannels) {
   TempDir dir;
   auto images = make_frames(dir.path(), {"a.png", "b.png"});

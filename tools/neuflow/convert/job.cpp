@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -14,6 +15,7 @@
 #include "convert/index.hpp"
 #include "convert/interruption.hpp"
 #include "neuflow/flow/errors.hpp"
+#include "neuflow/flow/figures.hpp"
 #include "neuflow/flow/visualize.hpp"
 #include "neuflow/pipeline/pipeline_error.hpp"
 #include "neuflow/pipeline/video_encoder.hpp"
@@ -101,7 +103,7 @@ class Conversion {
  private:
   void convert_pair(const Frame& from, const Frame& to, InputOutcome& outcome);
   flow::FlowField compute(const Frame& from, const Frame& to);
-  void render(const flow::FlowField& field, const std::string& stem, bool write_png);
+  void render(const flow::FlowField& field, const Frame& from, bool write_png);
 
   const InputSpec& input_;
   model::FlowSession& session_;
@@ -220,7 +222,7 @@ void Conversion::convert_pair(const Frame& from, const Frame& to, InputOutcome& 
   }
   // A kept flow keeps its rendering too, unless that one is missing or cut short.
   const bool write_png = settings_.viz == VizMode::png && !(skipped && complete_png(png_path, width, height));
-  render(*field, from.output_stem, write_png);
+  render(*field, from, write_png);
 
   // A row's index is the pair's position in the whole input, so the ranges' indexes add up.
   const std::int64_t index = rows_ + (settings_.frames ? settings_.frames->first : 0);
@@ -255,13 +257,30 @@ flow::FlowField Conversion::compute(const Frame& from, const Frame& to) {
   }
 }
 
-void Conversion::render(const flow::FlowField& field, const std::string& stem, bool write_png) {
+// The frame's pixels as RGB, whatever order they are held in.
+flow::RgbImage rgb_of(const Frame& frame) {
+  const int w = frame.pixels.cols, h = frame.pixels.rows;
+  flow::RgbImage image{w, h, std::vector<std::uint8_t>(3 * static_cast<std::size_t>(w) * h)};
+  cv::Mat rgb(h, w, CV_8UC3, image.rgb.data());
+  if (frame.data_order == model::ChannelOrder::bgr) {
+    cv::cvtColor(frame.pixels, rgb, cv::COLOR_BGR2RGB);
+  } else {
+    frame.pixels.copyTo(rgb);
+  }
+  return image;
+}
+
+// The opacity of the colours over the frame: the neuflowviz element's default.
+constexpr double kOverlayAlpha = 0.6;
+
+void Conversion::render(const flow::FlowField& field, const Frame& from, bool write_png) {
   if (settings_.viz == VizMode::none || (settings_.viz == VizMode::png && !write_png)) return;
   flow::VisualizeOptions options;
   options.max_flow = settings_.max_flow;
-  const flow::RgbImage image = flow::visualize_flow(field, options).image;
+  flow::RgbImage image = flow::visualize_flow(field, options).image;
+  if (settings_.viz_look == VizLook::overlay) image = flow::blend(rgb_of(from), image, kOverlayAlpha);
   if (settings_.viz == VizMode::png) {
-    flow::write_rgb_png(image, dir_ / "viz" / (stem + ".png"));
+    flow::write_rgb_png(image, dir_ / "viz" / (from.output_stem + ".png"));
     return;
   }
   if (!video_) {

@@ -7,7 +7,7 @@
 //   <stem>.flo|.npy|.png  the flow from the frame named <stem> to the next one: the image's
 //                          stem for folders and pairs, frame_000123 (frame 123 → 124) for
 //                          videos
-//   viz/<stem>.png         its colour rendering (--viz png)
+//   viz/<stem>.png         its colour rendering (--viz png), alone or over the frame (--viz-mode)
 //   viz.mp4                all renderings as an H.264 video (--viz video)
 //   index.csv              one row per pair (see convert/index.hpp)
 //   settings.toml          what made the flows (convert/output_record.hpp)
@@ -30,6 +30,8 @@
 namespace neuflow::cli {
 
 enum class VizMode { none, png, video };
+// What a rendering shows: the flow's colours alone, or blended over the pair's first frame.
+enum class VizLook { flow, overlay };
 
 // The pairs whose first frame is A <= n < B (frames A to B, counted from 0): ranges that meet
 // (0:100, 100:200) share one frame and together hold every pair of the whole input once.
@@ -44,6 +46,7 @@ struct ConvertSettings {
   std::filesystem::path output_dir;
   flow::FlowFormat format = flow::FlowFormat::flo;
   VizMode viz = VizMode::none;
+  VizLook viz_look = VizLook::flow;
   double max_flow = 20;  // px at full saturation, fixed so colours mean the same in every frame
   bool resume = false;   // keep flow files that exist and read back at the right size
   // With resume: recompute a folder made with other settings instead of refusing it.

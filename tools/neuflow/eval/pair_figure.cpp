@@ -7,6 +7,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "neuflow/flow/figures.hpp"
+#include "neuflow/flow/metrics.hpp"
+
 namespace neuflow::eval {
 
 namespace {
@@ -14,40 +17,11 @@ namespace {
 constexpr int kGap = 4;
 constexpr std::uint8_t kGapGrey = 128;
 
-bool finite_pixel(const flow::FlowField& f, int x, int y) {
-  return std::isfinite(f.u(x, y)) && std::isfinite(f.v(x, y));
-}
-
 void paste(flow::RgbImage& canvas, const flow::RgbImage& panel, int left) {
   for (int y = 0; y < panel.height; ++y) {
     std::copy_n(panel.rgb.begin() + static_cast<std::ptrdiff_t>(3) * y * panel.width, 3 * panel.width,
                 canvas.rgb.begin() + 3 * (static_cast<std::ptrdiff_t>(y) * canvas.width + left));
   }
-}
-
-// |predicted - ground truth| where the ground truth is valid, as grey levels scaled to the
-// pair's largest error; black where nothing is scored.
-flow::RgbImage error_panel(const flow::FlowField& predicted, const flow::FlowField& ground_truth) {
-  const int w = ground_truth.width, h = ground_truth.height;
-  std::vector<double> epe(static_cast<std::size_t>(w) * h, -1.0);
-  double largest = 0;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (!ground_truth.is_valid(x, y) || !finite_pixel(ground_truth, x, y)) continue;
-      const double e = std::hypot(predicted.u(x, y) - ground_truth.u(x, y), predicted.v(x, y) - ground_truth.v(x, y));
-      // A non-finite prediction is the worst error there is: drawn white.
-      epe[static_cast<std::size_t>(y) * w + x] = std::isfinite(e) ? e : INFINITY;
-      if (std::isfinite(e)) largest = std::max(largest, e);
-    }
-  }
-  flow::RgbImage image{w, h, std::vector<std::uint8_t>(3 * static_cast<std::size_t>(w) * h, 0)};
-  for (std::size_t i = 0; i < epe.size(); ++i) {
-    if (epe[i] < 0) continue;
-    const double level = largest > 0 ? std::min(1.0, epe[i] / largest) : 0.0;
-    const auto grey = static_cast<std::uint8_t>(std::lround(level * 255));
-    image.rgb[3 * i] = image.rgb[3 * i + 1] = image.rgb[3 * i + 2] = grey;
-  }
-  return image;
 }
 
 std::string xml_text(const std::string& s) {
@@ -81,9 +55,14 @@ flow::RgbImage pair_figure(const flow::FlowField& predicted, const flow::FlowFie
   options.max_flow = std::max(flow::max_flow_magnitude(ground_truth), 1e-6);  // one scale for both flows
   flow::FlowField masked = predicted;
   masked.valid = ground_truth.valid;  // the prediction is shown where the ground truth is known
-  const flow::RgbImage left = flow::visualize_flow(masked, options).image;
-  const flow::RgbImage middle = flow::visualize_flow(ground_truth, options).image;
-  const flow::RgbImage right = error_panel(predicted, ground_truth);
+  flow::RgbImage left = flow::visualize_flow(masked, options).image;
+  flow::RgbImage middle = flow::visualize_flow(ground_truth, options).image;
+  flow::RgbImage right = flow::error_map(predicted, ground_truth);
+  flow::draw_label(left, "prediction");
+  flow::draw_label(middle, "ground truth");
+  const double epe = flow::compute_metrics(predicted, ground_truth).epe;
+  flow::draw_label(right, std::isfinite(epe) ? "error, EPE " + number(epe, 2) + " px" : std::string("error"));
+  flow::draw_key(middle, *options.max_flow);  // the scale of both flow panels
 
   const int w = ground_truth.width, h = ground_truth.height;
   flow::RgbImage canvas{3 * w + 2 * kGap, h, {}};

@@ -1,8 +1,9 @@
 #pragma once
 // Pictures of an evaluation, because people would rather look than read:
 // - one PNG per pair: the prediction, the ground truth and the end-point-error map side by
-//   side, the two flows on one colour scale (the ground truth's largest valid vector), the
-//   error on its own (black: none, white: the pair's largest error), invalid pixels black;
+//   side, each labelled; the two flows on one colour scale (the ground truth's largest valid
+//   vector), its key drawn on the ground truth; the error as a colour map with its scale bar
+//   (flow/figures.hpp) and the pair's EPE in its label; invalid pixels black;
 // - an SVG bar chart of the EPE per sequence.
 #include <filesystem>
 #include <vector>
