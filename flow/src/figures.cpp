@@ -16,7 +16,8 @@ namespace neuflow::flow {
 namespace {
 
 void check_image(const RgbImage& image) {
-  if (image.width < 1 || image.height < 1 || image.rgb.size() != 3 * static_cast<std::size_t>(image.width) * image.height) {
+  if (image.width < 1 || image.height < 1 ||
+      image.rgb.size() != 3 * static_cast<std::size_t>(image.width) * image.height) {
     throw std::invalid_argument("an empty or inconsistent picture");
   }
 }
@@ -25,9 +26,7 @@ void check_image(const RgbImage& image) {
 cv::Mat as_mat(RgbImage& image) { return {image.height, image.width, CV_8UC3, image.rgb.data()}; }
 
 // Text sizes that read at the picture's scale: Hershey simplex from 0.35 (tiny pictures) to 0.8.
-double font_scale(const RgbImage& image) {
-  return std::clamp(std::min(image.width, image.height) / 600.0, 0.35, 0.8);
-}
+double font_scale(const RgbImage& image) { return std::clamp(std::min(image.width, image.height) / 600.0, 0.35, 0.8); }
 
 // Text at (x, baseline y), white on a dark box; returns the box's width.
 int boxed_text(cv::Mat& mat, const std::string& text, int x, int y, double scale) {
@@ -127,7 +126,8 @@ RgbImage error_map(const FlowField& predicted, const FlowField& ground_truth, do
   double largest = 0;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      if (!ground_truth.is_valid(x, y) || !std::isfinite(ground_truth.u(x, y)) || !std::isfinite(ground_truth.v(x, y))) {
+      if (!ground_truth.is_valid(x, y) || !std::isfinite(ground_truth.u(x, y)) ||
+          !std::isfinite(ground_truth.v(x, y))) {
         continue;
       }
       const double e = std::hypot(predicted.u(x, y) - ground_truth.u(x, y), predicted.v(x, y) - ground_truth.v(x, y));

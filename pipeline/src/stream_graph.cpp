@@ -4,9 +4,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 #include <system_error>
+#include <variant>
 
 #include "neuflow/pipeline/graph_plan.hpp"
+#include "neuflow/pipeline/output_record.hpp"
 
 namespace neuflow::pipeline {
 
@@ -58,6 +61,23 @@ void create_folders(const std::vector<fs::path>& folders) {
     fs::create_directories(folder, ec);
     if (ec) throw std::runtime_error("cannot create " + folder.string() + ": " + ec.message());
   }
+}
+
+// What a files sink's flows are made with, as `neuflow convert` records its folders; the backend
+// as configured (auto stays auto), the network's own padding (centred).
+OutputRecord files_sink_record(const FlowStage& flow, const FilesSink& sink) {
+  const model::SessionOptions& o = flow.session;
+  OutputRecord record;
+  record.model_sha1 = model_sha1(flow.model);
+  record.iters_s16 = o.iterations.s16;
+  record.iters_s8 = o.iterations.s8;
+  record.model_width = o.model_width;
+  record.model_height = o.model_height;
+  record.channel_order = std::string(model::channel_order_name(o.network_order));
+  record.backend = std::string(model::backend_name(o.backend));
+  record.precision = std::string(model::precision_name(o.precision));
+  record.format = sink.format;
+  return record;
 }
 
 GstPadProbeReturn drop_when_failed(GstPad*, GstPadProbeInfo*, gpointer user_data) {
@@ -153,6 +173,10 @@ std::unique_ptr<StreamGraph> build_stream_graph(const GraphDescription& descript
     try {
       const SinkPlan plan = plan_sink(description.name, sink, context);
       create_folders(plan.folders);
+      // A folder of flows made otherwise is not added to: this sink is cut off, naming why.
+      if (const auto* files = std::get_if<FilesSink>(&sink.settings)) {
+        claim_folder(files->directory, files_sink_record(description.flow, *files), "neuflowd");
+      }
       const auto [first, last] = add_chain(GST_BIN(branch->bin), plan.chain);
       if (g_object_class_find_property(G_OBJECT_GET_CLASS(last), "flows-written")) branch->writer = last;
       GstPad* first_sink = gst_element_get_static_pad(first, "sink");

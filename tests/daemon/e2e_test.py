@@ -239,8 +239,12 @@ class DaemonTestCase(unittest.TestCase):
             d.close()
         shutil.rmtree(self.dir, ignore_errors=True)
 
-    def start(self, config_text, **kw):
-        d = Daemon(self.dir, config_text, **kw)
+    def start(self, config_text, folder=None, **kw):
+        # A daemon after another in one test gets a folder of its own (its config, log and
+        # notify socket).
+        folder = folder or self.dir
+        os.makedirs(folder, exist_ok=True)
+        d = Daemon(folder, config_text, **kw)
         self.daemons.append(d)
         return d
 
@@ -726,6 +730,42 @@ class DaemonReliability(DaemonTestCase):
         self.assertNotIn("restarting in", d.log_text())
         self.assertEqual(d.stop(), 0)
 
+    def test_a_files_sink_records_its_settings_and_refuses_a_folder_made_otherwise(self):
+        # As `neuflow convert` does: settings.toml beside index.csv says what made the flows,
+        # and flows made with other settings are not added to them.
+        flows = os.path.join(self.dir, "flows")
+        other = os.path.join(self.dir, "other")
+
+        def config(iters):
+            return stream_block("s", test_source(), [
+                f'  type = "files"\n  name = "kept"\n  directory = "{flows}"',
+                f'  type = "files"\n  name = "other"\n  directory = "{other}-{iters}"',
+            ]).replace("iters-s8 = 1", f"iters-s8 = {iters}")
+
+        d = self.start(config(1))
+        d.wait_ready(60)
+        wait_until(lambda: len(flow_files(flows)) >= 3, 60, "no flows")
+        self.assertEqual(d.stop(), 0)
+        with open(os.path.join(flows, "settings.toml")) as f:
+            record = f.read()
+        self.assertRegex(record, r"(?m)^iters_s8 = 1$")
+        self.assertRegex(record, r"(?m)^model_sha1 = '[0-9a-f]{40}'$")
+        self.assertRegex(record, r"(?m)^format = 'flo'$")
+        before = len(flow_files(flows))
+
+        d = self.start(config(2), folder=os.path.join(self.dir, "second"))
+        d.wait_ready(60)
+        d.wait_log(r"stream s: sink kept cannot be built: .*flows made with other settings "
+                   r"\(iters-s8 1 \(now 2\)\).*other sinks", timeout=30)
+        wait_until(lambda: len(flow_files(other + "-2")) >= 3, 60, "the other sink wrote no flows")
+        self.assertEqual(len(flow_files(flows)), before, "flows were added to a folder made otherwise")
+        self.assertEqual(d.stop(), 0)
+
+        d = self.start(config(1), folder=os.path.join(self.dir, "third"))  # the same settings: taken up again
+        d.wait_ready(60)
+        wait_until(lambda: len(flow_files(flows)) > before, 60, "the folder was not taken up again")
+        self.assertEqual(d.stop(), 0)
+
     def test_a_display_sink_without_a_display_is_cut_off_and_the_daemon_runs_on(self):
         # autovideosink's probe of kmssink/dfbvideosink used to take the whole process down
         # (exit 139) here; now the window sink follows the environment, and without a display
@@ -823,12 +863,13 @@ class DaemonReliability(DaemonTestCase):
 
         def config(variant):
             width, height, iters = (320, 240, 4) if variant == "a" else (256, 192, 6)
+            # A folder per variant: a files sink refuses a folder of flows made otherwise.
             return (f'[metrics]\nlisten = "127.0.0.1:{metrics_port}"\n' +
                     stream_block("changes", test_source(fps=15, width=320, height=240), [
-                        '  type = "files"\n  directory = "%s"\n  max-files = 10' % os.path.join(self.dir, "a")])
+                        '  type = "files"\n  directory = "%s"\n  max-files = 10' % os.path.join(self.dir, variant)])
                     .replace("iters-s8 = 1", f"iters-s8 = {iters}\n  model-width = {width}\n  model-height = {height}") +
                     stream_block("steady", test_source(fps=15, width=320, height=240), [
-                        '  type = "files"\n  directory = "%s"\n  max-files = 10' % os.path.join(self.dir, "b")]))
+                        '  type = "files"\n  directory = "%s"\n  max-files = 10' % os.path.join(self.dir, "steady")]))
 
         def rss_mb(pid):
             with open(f"/proc/{pid}/status") as f:

@@ -57,7 +57,8 @@ TEST(FlowArrows, CoverTheSegmentFromEachCellCentre) {
   // Anchors at 12 and 36; each arrow runs 8 px to the right.
   for (const int y : {12, 36}) {
     for (const int x0 : {12, 36}) {
-      for (int x = x0 + 1; x < x0 + 7; ++x) EXPECT_GT(coverage[static_cast<std::size_t>(y) * 48 + x], 100) << x << "," << y;
+      for (int x = x0 + 1; x < x0 + 7; ++x)
+        EXPECT_GT(coverage[static_cast<std::size_t>(y) * 48 + x], 100) << x << "," << y;
       EXPECT_EQ(coverage[static_cast<std::size_t>(y) * 48 + x0 - 3], 0) << "nothing behind the anchor";
     }
   }

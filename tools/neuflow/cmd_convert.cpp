@@ -136,8 +136,8 @@ CommandError interrupted(const InputSpec& input, const InputOutcome& outcome, st
 
 // What this run makes its flows with. The backend is the one the session opened (auto names
 // where it ran); the model, its content.
-OutputRecord record_of(const std::string& model_path, const std::string& format, const std::string& padding,
-                       const model::FlowSession& session) {
+pipeline::OutputRecord record_of(const std::string& model_path, const std::string& format, const std::string& padding,
+                                 const model::FlowSession& session) {
   const model::SessionOptions& o = session.options();
   const std::string& where = session.backend_description();
   std::string model_sha1;

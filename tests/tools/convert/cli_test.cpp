@@ -448,14 +448,30 @@ TEST_F(ConvertCli, ImagePairAsTwoFilesOrWithPair) {
   const auto result = convert(dir / "out", {(dir / "left.png").string(), (dir / "right.png").string(), "--pair",
                                             (dir / "right.png").string(), (dir / "left.png").string()});
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  const auto forward = flow::read_flow(dir / "out" / "left_right" / "left.flo");
-  const auto backward = flow::read_flow(dir / "out" / "right_left" / "right.flo");
+  const auto forward = flow::read_flow(dir / "out" / "left_right" / "flow.flo");
+  const auto backward = flow::read_flow(dir / "out" / "right_left" / "flow.flo");
   EXPECT_LT(max_difference(forward, reference_flow(images[0], images[1])), 1e-4);
   EXPECT_LT(max_difference(backward, reference_flow(images[1], images[0])), 1e-4);
   const auto index = read_csv(dir / "out" / "left_right" / "index.csv");
   ASSERT_EQ(index.size(), 2u);
+  EXPECT_EQ(index[1][5], "flow.flo");
   EXPECT_EQ(index[1][6], "left.png");
   EXPECT_EQ(index[1][7], "right.png");
+}
+
+// A pair's KITTI flow is not named like the image it starts from (left.png beside left.png's
+// rendering would pass for a copy of the image).
+TEST_F(ConvertCli, APairsKittiFlowIsNotNamedAfterItsImage) {
+  TempDir dir;
+  make_frames(dir.path(), {"left.png", "right.png"});
+  const auto result = convert(dir / "out", {"--pair", (dir / "left.png").string(), (dir / "right.png").string(),
+                                            "--format", "png", "--viz", "png"});
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const fs::path folder = dir / "out" / "left_right";
+  EXPECT_TRUE(flow::read_flow(folder / "flow.png").has_mask());
+  EXPECT_TRUE(fs::exists(folder / "viz" / "flow.png"));
+  EXPECT_FALSE(fs::exists(folder / "left.png"));
+  EXPECT_FALSE(fs::exists(folder / "viz" / "left.png"));
 }
 
 TEST_F(ConvertCli, KittiFlowsAndPngRenderings) {
@@ -506,7 +522,8 @@ TEST_F(ConvertCli, BgrChannelOrderFeedsTheNetworkSwappedChannels) {
   ASSERT_EQ(result.exit_code, 0) << result.output;
   for (auto& image : images) cv::cvtColor(image, image, cv::COLOR_BGR2RGB);
   // The reference reads the swapped images as BGR, so the network sees the original BGR as RGB.
-  EXPECT_LT(max_difference(flow::read_flow(dir / "out" / "a_b" / "a.flo"), reference_flow(images[0], images[1])), 1e-4);
+  EXPECT_LT(max_difference(flow::read_flow(dir / "out" / "a_b" / "flow.flo"), reference_flow(images[0], images[1])),
+            1e-4);
 }
 
 TEST_F(ConvertCli, SingleFrameAndEmptyFolderFail) {

@@ -179,9 +179,13 @@ pipeline::FrameRate rate_from_timestamps(const std::vector<std::string>& stems) 
 std::unique_ptr<FrameSource> open_frames(const InputSpec& input, FrameSizeCheck check) {
   if (input.rejected) throw *input.rejected;
   switch (input.kind) {
-    case InputKind::image_pair:
-      return std::make_unique<ImageSequence>(name_images({fs::path(input.paths[0]), fs::path(input.paths[1])}),
-                                             std::move(check));
+    case InputKind::image_pair: {
+      // The pair's folder (a_b/) already names both images; its one flow is flow.<ext>, so a
+      // KITTI .png flow beside them is not taken for the first image, whose name it had.
+      auto files = name_images({fs::path(input.paths[0]), fs::path(input.paths[1])});
+      files[0].output_stem = "flow";
+      return std::make_unique<ImageSequence>(std::move(files), std::move(check));
+    }
     case InputKind::image_folder: {
       auto images = list_images(input.paths[0]);
       if (images.empty()) {

@@ -122,15 +122,15 @@ class Conversion {
 // them; otherwise it refuses the folder, or with --overwrite recomputes it.
 bool may_resume(const fs::path& dir, const ConvertSettings& settings) {
   if (!settings.resume) return false;
-  std::optional<OutputRecord> was;
+  std::optional<pipeline::OutputRecord> was;
   try {
-    was = read_record(dir);
-  } catch (const InputError&) {
+    was = pipeline::read_record(dir);
+  } catch (const pipeline::OutputRecordError& e) {
     if (settings.overwrite) return false;
-    throw;
+    throw InputError(kExitDataError, std::string(e.what()) + " (delete it, or give --overwrite)");
   }
   if (!was) return true;  // written before folders had records
-  const std::vector<std::string> differences = record_differences(*was, settings.record);
+  const std::vector<std::string> differences = pipeline::record_differences(*was, settings.record, "--");
   if (differences.empty()) return true;
   if (settings.overwrite) return false;
   std::string list;
@@ -144,7 +144,11 @@ void Conversion::run(InputOutcome& outcome) {
   create_folder(dir_);
   if (settings_.resume) remove_stale_partials(dir_);
   resume_ = may_resume(dir_, settings_);
-  write_record(dir_, settings_.record);
+  try {
+    pipeline::write_record(dir_, settings_.record, "neuflow convert");
+  } catch (const pipeline::OutputRecordError& e) {
+    throw InputError(kExitCantCreate, e.what());
+  }
   if (settings_.viz == VizMode::png) create_folder(dir_ / "viz");
   session_.reset();
 

@@ -5,12 +5,12 @@
 //
 // Output layout, in <output>/<input's output_name>/:
 //   <stem>.flo|.npy|.png  the flow from the frame named <stem> to the next one: the image's
-//                          stem for folders and pairs, frame_000123 (frame 123 → 124) for
-//                          videos
+//                          stem for folders, frame_000123 (frame 123 → 124) for videos,
+//                          flow for a pair (its folder names both images)
 //   viz/<stem>.png         its colour rendering (--viz png), alone or over the frame (--viz-mode)
 //   viz.mp4                all renderings as an H.264 video (--viz video)
 //   index.csv              one row per pair (see convert/index.hpp)
-//   settings.toml          what made the flows (convert/output_record.hpp)
+//   settings.toml          what made the flows (neuflow/pipeline/output_record.hpp)
 // With --frames A:B the index and the video are index.A-B.csv and viz.A-B.mp4, so jobs that
 // take other ranges of the same input write beside each other.
 #include <cstdint>
@@ -20,12 +20,12 @@
 
 #include "convert/input_error.hpp"
 #include "convert/inputs.hpp"
-#include "convert/output_record.hpp"
 #include "convert/progress.hpp"
 #include "neuflow/eval/padding.hpp"
 #include "neuflow/flow/flow_io.hpp"
 #include "neuflow/model/flow_session.hpp"
 #include "neuflow/pipeline/frame_rate.hpp"
+#include "neuflow/pipeline/output_record.hpp"
 
 namespace neuflow::cli {
 
@@ -51,7 +51,7 @@ struct ConvertSettings {
   bool resume = false;   // keep flow files that exist and read back at the right size
   // With resume: recompute a folder made with other settings instead of refusing it.
   bool overwrite = false;
-  OutputRecord record;               // what this run makes its flows with, written into each folder
+  pipeline::OutputRecord record;     // what this run makes its flows with, written into each folder
   std::int64_t max_frames = 0;       // 0: every frame; else only the first max_frames of each input
   std::optional<FrameRange> frames;  // --frames A:B: one range of each input's pairs
   // The rate of viz.mp4 for images (a video keeps its own): unset, the rate the file names'

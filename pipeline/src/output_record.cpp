@@ -1,4 +1,4 @@
-#include "convert/output_record.hpp"
+#include "neuflow/pipeline/output_record.hpp"
 
 #include <toml++/toml.h>
 
@@ -11,10 +11,9 @@
 #include <system_error>
 #include <type_traits>
 
-#include "common/exit_codes.hpp"
-#include "convert/input_error.hpp"
+#include "neuflow/pipeline/git_blob_hash.hpp"
 
-namespace neuflow::cli {
+namespace neuflow::pipeline {
 
 namespace fs = std::filesystem;
 
@@ -23,7 +22,7 @@ namespace {
 // Each field once: its key in the file and the option that sets it.
 struct Field {
   const char* key;
-  const char* option;
+  const char* option;  // the setting's name, without the command line's "--"
   const char* absent;  // what a record without the key holds (one written before it existed); null: required
   std::function<std::string(const OutputRecord&)> text;
   std::function<void(OutputRecord&, const toml::node&)> read;
@@ -63,17 +62,17 @@ Field field(const char* key, const char* option, T OutputRecord::*member) {
 
 const std::vector<Field>& fields() {
   static const std::vector<Field> all{
-      field("model_sha1", "--model (its git blob SHA-1)", &OutputRecord::model_sha1),
-      field("iters_s16", "--iters-s16", &OutputRecord::iters_s16),
-      field("iters_s8", "--iters-s8", &OutputRecord::iters_s8),
-      field("model_width", "--model-width", &OutputRecord::model_width),
-      field("model_height", "--model-height", &OutputRecord::model_height),
-      field("channel_order", "--channel-order", &OutputRecord::channel_order),
-      field("backend", "--backend", &OutputRecord::backend),
-      field("precision", "--precision", &OutputRecord::precision),
-      field("format", "--format", &OutputRecord::format),
+      field("model_sha1", "model (its git blob SHA-1)", &OutputRecord::model_sha1),
+      field("iters_s16", "iters-s16", &OutputRecord::iters_s16),
+      field("iters_s8", "iters-s8", &OutputRecord::iters_s8),
+      field("model_width", "model-width", &OutputRecord::model_width),
+      field("model_height", "model-height", &OutputRecord::model_height),
+      field("channel_order", "channel-order", &OutputRecord::channel_order),
+      field("backend", "backend", &OutputRecord::backend),
+      field("precision", "precision", &OutputRecord::precision),
+      field("format", "format", &OutputRecord::format),
       [] {
-        Field f = field("padding", "--padding", &OutputRecord::padding);
+        Field f = field("padding", "padding", &OutputRecord::padding);
         f.absent = "centred";
         return f;
       }(),
@@ -104,41 +103,63 @@ std::optional<OutputRecord> read_record(const fs::path& folder) {
     }
     return r;
   } catch (const toml::parse_error& e) {
-    throw InputError(kExitDataError, path.string() + ": not a record of the settings a folder was made with: " +
-                                         std::string(e.description()) + " (delete it, or give --overwrite)");
+    throw OutputRecordError(
+        OutputRecordError::Kind::malformed,
+        path.string() + ": not a record of the settings a folder was made with: " + std::string(e.description()));
   } catch (const std::invalid_argument& e) {
-    throw InputError(kExitDataError, path.string() + ": not a record of the settings a folder was made with: " +
-                                         e.what() + " (delete it, or give --overwrite)");
+    throw OutputRecordError(OutputRecordError::Kind::malformed,
+                            path.string() + ": not a record of the settings a folder was made with: " + e.what());
   }
 }
 
-void write_record(const fs::path& folder, const OutputRecord& record) {
+void write_record(const fs::path& folder, const OutputRecord& record, std::string_view writer) {
   const fs::path path = record_path(folder);
   const fs::path temporary = path.string() + ".partial-" + std::to_string(::getpid());
   {
     std::ofstream out(temporary);
-    out << "# What made the flows in this folder (neuflow convert). `--resume` refuses to add\n"
-           "# flows made with other settings to them; `--resume --overwrite` recomputes them.\n";
+    out << "# What made the flows in this folder (" << writer
+        << "). neuflow convert --resume and neuflowd's files sink\n"
+           "# refuse to add flows made with other settings to them.\n";
     toml::table table;
     for (const Field& f : fields()) f.write(table, record);
     out << table << "\n";
-    if (!out.flush()) throw InputError(kExitCantCreate, temporary.string() + ": cannot write the folder's record");
+    if (!out.flush()) {
+      throw OutputRecordError(OutputRecordError::Kind::unwritable,
+                              temporary.string() + ": cannot write the folder's record");
+    }
   }
   std::error_code ec;
   fs::rename(temporary, path, ec);
   if (ec) {
     fs::remove(temporary, ec);
-    throw InputError(kExitCantCreate, path.string() + ": cannot write the folder's record");
+    throw OutputRecordError(OutputRecordError::Kind::unwritable, path.string() + ": cannot write the folder's record");
   }
 }
 
-std::vector<std::string> record_differences(const OutputRecord& was, const OutputRecord& now) {
+std::vector<std::string> record_differences(const OutputRecord& was, const OutputRecord& now, std::string_view prefix) {
   std::vector<std::string> out;
   for (const Field& f : fields()) {
     const std::string a = f.text(was), b = f.text(now);
-    if (a != b) out.push_back(std::string(f.option) + " " + a + " (now " + b + ")");
+    if (a != b) out.push_back(std::string(prefix) + f.option + " " + a + " (now " + b + ")");
   }
   return out;
 }
 
-}  // namespace neuflow::cli
+void claim_folder(const fs::path& folder, const OutputRecord& record, std::string_view writer) {
+  if (const std::optional<OutputRecord> was = read_record(folder)) {
+    const std::vector<std::string> differences = record_differences(*was, record, "");
+    if (!differences.empty()) {
+      std::string list;
+      for (const auto& d : differences) list += (list.empty() ? "" : ", ") + d;
+      throw OutputRecordError(OutputRecordError::Kind::other_settings,
+                              folder.string() + " holds flows made with other settings (" + list +
+                                  "): point the sink at another folder, or move those flows and " +
+                                  record_path(folder).filename().string() + " away");
+    }
+  }
+  write_record(folder, record, writer);
+}
+
+std::string model_sha1(const fs::path& model) { return git_blob_sha1_of_file(model); }
+
+}  // namespace neuflow::pipeline
