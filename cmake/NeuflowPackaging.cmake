@@ -82,9 +82,10 @@ set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_NAME neuflow-dev)
 set(CPACK_DEBIAN_DEVELOPMENT_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_SECTION libdevel)
-# What neuflowConfig.cmake finds again for the static libraries, and the plugin's headers' own.
+# What neuflowConfig.cmake finds again for the static libraries (no installed header includes
+# Vulkan or volk: the loader is opened at run time), and flow_meta.h's GStreamer.
 set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS
-    "neuflow (= ${neuflow_deb_version}), cmake, pkg-config, libdnnl-dev, libopencv-core-dev, libopencv-imgproc-dev, libopencv-imgcodecs-dev, libopencv-video-dev, libpng-dev, libzip-dev, libvulkan-dev, libvulkan-volk-dev, libgstreamer1.0-dev")
+    "neuflow (= ${neuflow_deb_version}), cmake, pkg-config, libdnnl-dev, libopencv-core-dev, libopencv-imgproc-dev, libopencv-imgcodecs-dev, libopencv-video-dev, libpng-dev, libzip-dev, libgstreamer1.0-dev")
 set(CPACK_COMPONENT_DEVELOPMENT_DESCRIPTION "NeuFlow-V2 optical flow: headers, static libraries and CMake package
 find_package(neuflow) gives neuflow::model (the network, its sessions, the CPU and Vulkan
 backends) and neuflow::flow (flow fields, .flo / KITTI PNG / .npy, colour wheel, metrics).")

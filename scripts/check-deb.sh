@@ -7,8 +7,8 @@
 #     for the test (mmdebstrap, from Debian's archive), which pulls in its dependencies; there
 #     tests/package/installed_checks.sh runs (gst-inspect-1.0 without GST_PLUGIN_PATH, neuflowd
 #     --check-config on the examples in /etc/neuflow, systemd-analyze verify on the units, the
-#     user and group, a flow and a gst-launch pipeline); then the package is purged and nothing
-#     of it may remain.
+#     user and group, a flow and a gst-launch pipeline, the units enabled); then the package is
+#     purged and nothing of it may remain, no link to its units either.
 #
 # Usage: bash scripts/check-deb.sh [--packages-only] [BUILD_DIR]   (BUILD_DIR: build/release)
 #   --packages-only  build the packages only (build/release/packages), as the README's command
@@ -22,7 +22,6 @@ build=${1:-build/release}
 [ -f "$build/CPackConfig.cmake" ] || { echo "check-deb: $build is not a configured build folder (cmake --preset release)" >&2; exit 66; }
 build=$(cd "$build" && pwd)
 say() { echo "check-deb: $*"; }
-sudo=""; if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
 
 # --- the packages ---------------------------------------------------------------------------
 rm -rf "$build/packages"
@@ -71,7 +70,9 @@ start=$(date +%s)
 # systemd (systemd-analyze) and gstreamer1.0-tools (gst-inspect-1.0, gst-launch-1.0) are the
 # test's tools; pkg-config tells where GStreamer looks for plugins. Everything else comes from
 # the package's dependencies.
-$sudo mmdebstrap --quiet --variant=apt --mode="$([ -z "$sudo" ] && echo root || echo unshare)" \
+# The root lives only while mmdebstrap runs (TARGET /dev/null): nothing is left to clean up,
+# and as a user (unshare mode, in a user namespace) nothing owned by other ids either.
+mmdebstrap --quiet --variant=apt --mode="$([ "$(id -u)" -eq 0 ] && echo root || echo unshare)" \
   --include=systemd,gstreamer1.0-tools,pkgconf,libgstreamer1.0-dev \
   --dpkgopt='path-exclude=/usr/share/man/*' --dpkgopt='path-exclude=/usr/share/locale/*' \
   --customize-hook='mkdir -p "$1/tmp/neuflow-check"' \
@@ -80,7 +81,7 @@ $sudo mmdebstrap --quiet --variant=apt --mode="$([ -z "$sudo" ] && echo root || 
   --customize-hook='chroot "$1" bash /tmp/neuflow-check/installed_checks.sh /tmp/neuflow-check' \
   --customize-hook='chroot "$1" sh -c "dpkg -L neuflow > /tmp/neuflow-check/files"' \
   --customize-hook='chroot "$1" apt-get purge -y neuflow' \
-  --customize-hook='chroot "$1" sh -c "left=0; while read -r f; do if [ -e \"\$f\" ] && [ ! -d \"\$f\" ]; then echo \"left behind: \$f\"; left=1; fi; done < /tmp/neuflow-check/files; [ ! -e /etc/neuflow ] || { echo \"left behind: /etc/neuflow\"; left=1; }; exit \$left"' \
-  bookworm "$work/root"
+  --customize-hook='chroot "$1" sh -c "left=0; while read -r f; do if [ -e \"\$f\" ] && [ ! -d \"\$f\" ]; then echo \"left behind: \$f\"; left=1; fi; done < /tmp/neuflow-check/files; [ ! -e /etc/neuflow ] || { echo \"left behind: /etc/neuflow\"; left=1; }; links=\$(find /etc/systemd/system -name \"neuflowd*\"); [ -z \"\$links\" ] || { echo \"left behind: \$links\"; left=1; }; exit \$left"' \
+  bookworm /dev/null
 say "neuflow: installed with its dependencies into a clean Debian 12 root, checked, purged" \
     "without leftovers ($(( $(date +%s) - start )) s)"

@@ -45,6 +45,8 @@ std::string pixels(double v) {
   return buf;
 }
 
+constexpr std::uint8_t kUnscoredGrey = 96;
+
 // OpenCV's inferno map, index 0..255, as RGB.
 const std::vector<Rgb8>& inferno() {
   static const std::vector<Rgb8> table = [] {
@@ -136,7 +138,8 @@ RgbImage error_map(const FlowField& predicted, const FlowField& ground_truth, do
     }
   }
   const double top = max_error > 0 ? max_error : std::max(largest, 1.0);
-  RgbImage image{w, h, std::vector<std::uint8_t>(3 * static_cast<std::size_t>(w) * h, 0)};
+  // Unscored pixels grey: the map's own darkest colour is (almost) black, no error.
+  RgbImage image{w, h, std::vector<std::uint8_t>(3 * static_cast<std::size_t>(w) * h, kUnscoredGrey)};
   const auto& map = inferno();
   for (std::size_t i = 0; i < epe.size(); ++i) {
     if (epe[i] < 0) continue;

@@ -4,7 +4,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <stdexcept>
@@ -115,6 +117,8 @@ std::optional<OutputRecord> read_record(const fs::path& folder) {
 void write_record(const fs::path& folder, const OutputRecord& record, std::string_view writer) {
   const fs::path path = record_path(folder);
   const fs::path temporary = path.string() + ".partial-" + std::to_string(::getpid());
+  bool written = false;
+  int error = 0;
   {
     std::ofstream out(temporary);
     out << "# What made the flows in this folder (" << writer
@@ -123,16 +127,22 @@ void write_record(const fs::path& folder, const OutputRecord& record, std::strin
     toml::table table;
     for (const Field& f : fields()) f.write(table, record);
     out << table << "\n";
-    if (!out.flush()) {
-      throw OutputRecordError(OutputRecordError::Kind::unwritable,
-                              temporary.string() + ": cannot write the folder's record");
-    }
+    written = static_cast<bool>(out.flush());
+    error = errno;
   }
   std::error_code ec;
+  if (!written) {
+    fs::remove(temporary, ec);
+    throw OutputRecordError(
+        OutputRecordError::Kind::unwritable,
+        path.string() + ": cannot write the folder's record: " + std::strerror(error != 0 ? error : EIO));
+  }
   fs::rename(temporary, path, ec);
   if (ec) {
+    const std::string reason = ec.message();
     fs::remove(temporary, ec);
-    throw OutputRecordError(OutputRecordError::Kind::unwritable, path.string() + ": cannot write the folder's record");
+    throw OutputRecordError(OutputRecordError::Kind::unwritable,
+                            path.string() + ": cannot write the folder's record: " + reason);
   }
 }
 
@@ -146,7 +156,14 @@ std::vector<std::string> record_differences(const OutputRecord& was, const Outpu
 }
 
 void claim_folder(const fs::path& folder, const OutputRecord& record, std::string_view writer) {
-  if (const std::optional<OutputRecord> was = read_record(folder)) {
+  std::optional<OutputRecord> existing;
+  try {
+    existing = read_record(folder);
+  } catch (const OutputRecordError& e) {
+    throw OutputRecordError(
+        e.kind(), std::string(e.what()) + ": move it away (with the flows it describes) or point the sink elsewhere");
+  }
+  if (const std::optional<OutputRecord>& was = existing) {
     const std::vector<std::string> differences = record_differences(*was, record, "");
     if (!differences.empty()) {
       std::string list;

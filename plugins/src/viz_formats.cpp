@@ -28,6 +28,9 @@ GstCaps *viz_transform_caps(GstPadDirection direction, GstCaps *caps, GstCaps *f
                                    features != nullptr ? gst_caps_features_copy(features) : nullptr);
     GstStructure *other = gst_structure_copy(structure);
     gst_structure_set_value(other, "format", formats);
+    // A conversion between YUV and RGB changes what these mean (bt601 is no RGB colorimetry,
+    // sRGB no YUV one): as videoconvert does, the other side chooses its own.
+    gst_structure_remove_fields(other, "colorimetry", "chroma-site", nullptr);
     gst_caps_append_structure_full(converted, other, features != nullptr ? gst_caps_features_copy(features) : nullptr);
   }
   // The same format first, so a drawable one is kept and drawn in place.

@@ -91,7 +91,7 @@ TEST(FlowBlend, WeighsTheRenderingOverThePicture) {
   EXPECT_THROW(blend(under, over, 1.5), std::invalid_argument);
 }
 
-TEST(FlowErrorMap, ColoursTheErrorByItsScaleAndBlacksOutUnscoredPixels) {
+TEST(FlowErrorMap, ColoursTheErrorByItsScaleAndGreysOutUnscoredPixels) {
   constexpr int w = 200, h = 120;
   FlowField truth = uniform(w, h, 0, 0);
   truth.valid.assign(truth.pixel_count(), 1);
@@ -104,9 +104,10 @@ TEST(FlowErrorMap, ColoursTheErrorByItsScaleAndBlacksOutUnscoredPixels) {
   ASSERT_EQ(map.width, w);
   ASSERT_EQ(map.height, h);
   const Rgb8 half = pixel(map, 30, 70), none = pixel(map, 110, 70);
-  EXPECT_EQ(pixel(map, 10, 60), (Rgb8{0, 0, 0})) << "a pixel the ground truth does not score";
+  EXPECT_EQ(pixel(map, 10, 60), (Rgb8{96, 96, 96})) << "a pixel the ground truth does not score: grey";
   EXPECT_EQ(pixel(map, 60, 90), half) << "one error, one colour";
   EXPECT_LT(none[0] + none[1] + none[2], 40) << "no error is dark";
+  EXPECT_NE(none, pixel(map, 10, 60)) << "no error and not scored look alike";
   EXPECT_GT(half[0], 100) << "half the scale is the map's middle (inferno: crimson)";
   // The bar at the right edge: its top is the scale's end (bright yellow), its bottom dark.
   const int bar_x = w - std::max(3, w / 80) - 2;

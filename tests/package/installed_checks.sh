@@ -49,6 +49,11 @@ grep -q "^Environment=GST_PLUGIN_PATH_1_0=$(dirname "$plugin")$" "$units/neuflow
 verify=$(SYSTEMD_LOG_LEVEL=warning systemd-analyze verify "$units/neuflowd.service" "$units/neuflowd@.service" 2>&1) ||
   { echo "$verify"; fail "systemd-analyze verify rejects the units"; }
 ok "systemd-analyze verify: the units are valid${verify:+ ($verify)}"
+# Enabled as an administrator would, so that removing the package must disable them
+# (scripts/check-deb.sh looks for links left behind after the purge).
+systemctl enable neuflowd.service neuflowd@front.service > /dev/null 2>&1 ||
+  fail "systemctl enable neuflowd.service neuflowd@front.service"
+[ -L /etc/systemd/system/multi-user.target.wants/neuflowd@front.service ] || fail "the template's instance was not enabled"
 
 if [ -f "$data/checkpoint.pth" ]; then
   neuflow flow -m "$data/checkpoint.pth" --model-width 256 --model-height 144 --iters-s8 2 \

@@ -434,6 +434,14 @@ TEST(NeuflowViz, LinksAfterAYuvSourceWithoutVideoconvert) {
             GST_MESSAGE_EOS);
 }
 
+// A camera's YUV colorimetry is not carried over to the RGB side (nor sRGB to the YUV side), so
+// fixed caps on either side still link.
+TEST(NeuflowViz, ColorimetryDoesNotCrossTheConversion) {
+  EXPECT_EQ(play_to_end("videotestsrc num-buffers=3 ! video/x-raw,format=I420,width=64,height=48,colorimetry=bt601 ! "
+                        "neuflowviz ! video/x-raw,format=RGB,colorimetry=sRGB ! fakesink"),
+            GST_MESSAGE_EOS);
+}
+
 TEST(NeuflowViz, RgbFramesAreStillDrawnInPlace) {
   constexpr int w = 8, h = 6;
   auto harness = make_viz(GST_VIDEO_FORMAT_BGRx, w, h);

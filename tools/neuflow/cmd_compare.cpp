@@ -78,7 +78,13 @@ void run_compare(const CompareOptions& options) {
   metrics_options.use_predicted_mask = options.use_predicted_mask;
   const flow::FlowMetrics m = flow::compute_metrics(predicted, ground_truth, metrics_options);
   if (!options.error_map.empty()) {
-    flow::RgbImage map = flow::error_map(predicted, ground_truth);
+    // The pixels the EPE in its corner counts: with --pred-mask, also valid in the prediction.
+    flow::FlowField scored = ground_truth;
+    if (options.use_predicted_mask && predicted.has_mask()) {
+      if (!scored.has_mask()) scored.valid.assign(scored.pixel_count(), 1);
+      for (std::size_t i = 0; i < scored.valid.size(); ++i) scored.valid[i] &= predicted.valid[i];
+    }
+    flow::RgbImage map = flow::error_map(predicted, scored);
     char label[64];
     std::snprintf(label, sizeof label, std::isfinite(m.epe) ? "EPE %.3f px" : "EPE n/a", m.epe);
     flow::draw_label(map, label);
@@ -114,7 +120,7 @@ void register_compare(CLI::App& app) {
                 "they are)");
   cmd->add_option("--error-map", options->error_map,
                   "Also write the end-point error of every scored pixel as a PNG: a colour map (dark: none, "
-                  "yellow: the largest) with its scale bar, the EPE in the corner, unscored pixels black")
+                  "yellow: the largest) with its scale bar, the EPE in the corner, unscored pixels grey")
       ->check(png_name);
   cmd->callback([options] { run_compare(*options); });
 }

@@ -261,16 +261,19 @@ void register_convert(CLI::App& app) {
                   "Flow file format: flo (Middlebury), npy (H x W x 2 float32) or png (KITTI 16-bit)")
       ->check(CLI::IsMember({"flo", "npy", "png"}))
       ->capture_default_str();
-  sub->add_option("--viz", args->viz,
-                  "Colour rendering of each flow: png (viz/<frame>.png), video (viz.mp4, H.264, at the video's frame "
-                  "rate; for images --fps, else the rate their timestamp names give, else 10 fps) or none")
-      ->check(CLI::IsMember({"none", "png", "video"}))
-      ->capture_default_str();
+  CLI::Option* viz =
+      sub->add_option(
+             "--viz", args->viz,
+             "Colour rendering of each flow: png (viz/<frame>.png), video (viz.mp4, H.264, at the video's frame "
+             "rate; for images --fps, else the rate their timestamp names give, else 10 fps) or none")
+          ->check(CLI::IsMember({"none", "png", "video"}))
+          ->capture_default_str();
   sub->add_option("--viz-mode", args->viz_mode,
                   "What --viz shows: flow (the colours alone) or overlay (blended over the pair's first frame at "
                   "60 %, as the neuflowviz element's default)")
       ->check(CLI::IsMember({"flow", "overlay"}))
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(viz);
   sub->add_option("--max-flow", args->max_flow,
                   "Flow magnitude (px) drawn fully saturated in --viz; fixed so colours mean the same in every frame")
       ->capture_default_str()

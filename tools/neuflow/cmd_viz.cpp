@@ -99,17 +99,20 @@ void register_viz(CLI::App& app) {
                               ->check(CLI::PositiveNumber);
   cmd->add_flag("--key", options->key,
                 "Draw the colour wheel in the bottom-right corner, its rim at the max flow, labelled with it");
-  cmd->add_flag("--arrows", options->arrows,
-                "Draw an arrow every --arrow-spacing pixels; a vector of the max flow is one spacing long");
-  cmd->add_option("--arrow-spacing", options->arrow_spacing, "Pixels between arrows")
+  CLI::Option* arrows =
+      cmd->add_flag("--arrows", options->arrows,
+                    "Draw an arrow every --arrow-spacing pixels; a vector of the max flow is one spacing long");
+  cmd->add_option("--arrow-spacing", options->arrow_spacing, "Pixels between arrows (with --arrows)")
       ->capture_default_str()
-      ->check(CLI::Range(4, 1024));
-  cmd->add_option("--overlay", options->overlay,
-                  "Blend the rendering over this image (the flow's first frame, same size) instead of drawing it "
-                  "alone");
+      ->check(CLI::Range(4, 1024))
+      ->needs(arrows);
+  CLI::Option* overlay = cmd->add_option(
+      "--overlay", options->overlay,
+      "Blend the rendering over this image (the flow's first frame, same size) instead of drawing it alone");
   cmd->add_option("--alpha", options->alpha, "Opacity of the colours with --overlay (0: image only, 1: flow only)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(CLI::Range(0.0, 1.0))
+      ->needs(overlay);
   cmd->callback([options, max_flow] {
     options->fixed_max = max_flow->count() > 0;
     run_viz(*options);

@@ -94,9 +94,11 @@ case "$case_name" in
     expect_stderr "--overlay .* is [0-9]+x[0-9]+ but the flow is ${size}"
     run_expect 66 "$bin" viz "$gt/$1" -o "$work/bad.png" --overlay "$work/none.png"
     expect_stderr "cannot read it as an image"
+    run_expect 64 "$bin" viz "$gt/$1" -o "$work/bad.png" --alpha 0.5  # without --overlay: nothing to blend over
+    run_expect 64 "$bin" viz "$gt/$1" -o "$work/bad.png" --arrow-spacing 12
     [[ ! -e "$work/bad.png" ]] || fail "a picture was written for a bad --overlay"
     ;;
-  compare_error_map)  # compare_error_map FLOW: the error map of a flow against itself and against zero
+  compare_error_map)  # compare_error_map FLOW: the error map of a flow against itself (the map's colours: flow_tests)
     need_fixture "$1"
     run_expect 0 "$bin" compare "$gt/$1" "$gt/$1" --error-map "$work/self.png"
     is_png "$work/self.png" || fail "self.png is not a PNG"

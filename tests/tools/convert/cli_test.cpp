@@ -512,6 +512,8 @@ TEST_F(ConvertCli, VizModeOverlayBlendsTheRenderingOverTheFirstFrame) {
   }
   EXPECT_EQ(wrong, 0) << "channels that are not the 60 % blend of the frame and the flow's colours";
   EXPECT_EQ(convert(dir / "bad", {(dir / "seq").string(), "--viz", "png", "--viz-mode", "arrows"}).exit_code, 64);
+  EXPECT_EQ(convert(dir / "bad", {(dir / "seq").string(), "--viz-mode", "overlay"}).exit_code, 64)
+      << "--viz-mode without --viz draws nothing";
 }
 
 TEST_F(ConvertCli, BgrChannelOrderFeedsTheNetworkSwappedChannels) {

@@ -27,7 +27,7 @@ RgbImage blend(const RgbImage& under, const RgbImage& over, double alpha);
 
 // The end-point error |predicted - ground truth| of every pixel the ground truth marks valid,
 // through a perceptual colour map (dark: small, bright yellow: `max_error` and above; a
-// non-finite prediction is the largest error), black where nothing is scored, with a colour bar
+// non-finite prediction is the largest error), grey where nothing is scored, with a colour bar
 // labelled 0 and max_error at the right edge. max_error <= 0: the largest finite error (at
 // least 1 px). Throws std::invalid_argument when the fields differ in size.
 RgbImage error_map(const FlowField& predicted, const FlowField& ground_truth, double max_error = 0);

@@ -3,7 +3,8 @@
 // - one PNG per pair: the prediction, the ground truth and the end-point-error map side by
 //   side, each labelled; the two flows on one colour scale (the ground truth's largest valid
 //   vector), its key drawn on the ground truth; the error as a colour map with its scale bar
-//   (flow/figures.hpp) and the pair's EPE in its label; invalid pixels black;
+//   (flow/figures.hpp) and the pair's EPE in its label; pixels the ground truth does not score
+//   black in the flows, grey in the error;
 // - an SVG bar chart of the EPE per sequence.
 #include <filesystem>
 #include <vector>
