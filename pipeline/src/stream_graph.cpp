@@ -65,10 +65,10 @@ void create_folders(const std::vector<fs::path>& folders) {
 
 // What a files sink's flows are made with, as `neuflow convert` records its folders; the backend
 // as configured (auto stays auto), the network's own padding (centred).
-OutputRecord files_sink_record(const FlowStage& flow, const FilesSink& sink) {
+OutputRecord files_sink_record(const FlowStage& flow, const std::string& model_hash, const FilesSink& sink) {
   const model::SessionOptions& o = flow.session;
   OutputRecord record;
-  record.model_sha1 = model_sha1(flow.model);
+  record.model_sha1 = model_hash;
   record.iters_s16 = o.iterations.s16;
   record.iters_s8 = o.iterations.s8;
   record.model_width = o.model_width;
@@ -163,6 +163,7 @@ std::unique_ptr<StreamGraph> build_stream_graph(const GraphDescription& descript
 
   PlanContext context;
   context.first_free_index = next_free_index;
+  std::string model_hash;  // the flow stage's model's, once a files sink needs it
   for (const NamedSink& sink : description.sinks) {
     // A branch is built outside the pipeline, so one that cannot be built (its folder cannot
     // be created, an element is missing) leaves nothing behind and the other sinks still run.
@@ -175,7 +176,9 @@ std::unique_ptr<StreamGraph> build_stream_graph(const GraphDescription& descript
       create_folders(plan.folders);
       // A folder of flows made otherwise is not added to: this sink is cut off, naming why.
       if (const auto* files = std::get_if<FilesSink>(&sink.settings)) {
-        claim_folder(files->directory, files_sink_record(description.flow, *files), "neuflowd");
+        // The model is hashed once a graph, however many files sinks it has.
+        if (model_hash.empty()) model_hash = model_sha1(description.flow.model);
+        claim_folder(files->directory, files_sink_record(description.flow, model_hash, *files), "neuflowd");
       }
       const auto [first, last] = add_chain(GST_BIN(branch->bin), plan.chain);
       if (g_object_class_find_property(G_OBJECT_GET_CLASS(last), "flows-written")) branch->writer = last;

@@ -11,9 +11,12 @@
 
 #include "neuflow/flow/arrows.hpp"
 #include "neuflow/flow/colorwheel.hpp"
+#include "test_util.hpp"
 
 namespace neuflow::flow {
 namespace {
+
+using test::constant_field;
 
 RgbImage filled(int w, int h, std::uint8_t value) {
   return {w, h, std::vector<std::uint8_t>(3 * static_cast<std::size_t>(w) * h, value)};
@@ -22,15 +25,6 @@ RgbImage filled(int w, int h, std::uint8_t value) {
 Rgb8 pixel(const RgbImage& img, int x, int y) {
   const std::size_t i = 3 * (static_cast<std::size_t>(y) * img.width + x);
   return {img.rgb[i], img.rgb[i + 1], img.rgb[i + 2]};
-}
-
-FlowField uniform(int w, int h, float u, float v) {
-  FlowField f(w, h);
-  for (std::size_t i = 0; i < f.pixel_count(); ++i) {
-    f.uv[2 * i] = u;
-    f.uv[2 * i + 1] = v;
-  }
-  return f;
 }
 
 TEST(FlowKey, IsTheWheelWithItsRimAtMaxFlowInTheBottomRightCorner) {
@@ -50,7 +44,7 @@ TEST(FlowKey, IsTheWheelWithItsRimAtMaxFlowInTheBottomRightCorner) {
 }
 
 TEST(FlowArrows, CoverTheSegmentFromEachCellCentre) {
-  const FlowField field = uniform(4, 4, 8, 0);
+  const FlowField field = constant_field(4, 4, 8, 0);
   std::vector<std::uint8_t> coverage;
   arrow_coverage(field, 48, 48, 24, 1.0, std::numeric_limits<double>::infinity(), coverage);
   ASSERT_EQ(coverage.size(), 48u * 48u);
@@ -74,7 +68,7 @@ TEST(FlowArrows, AutomaticScaleDrawsMaxFlowOneSpacingLong) {
 
 TEST(FlowArrows, AreDrawnInTheirColour) {
   RgbImage image = filled(48, 48, 255);
-  draw_arrows(image, uniform(4, 4, 8, 0), 24, 1.0, 100.0, Rgb8{255, 0, 0});
+  draw_arrows(image, constant_field(4, 4, 8, 0), 24, 1.0, 100.0, Rgb8{255, 0, 0});
   const Rgb8 on = pixel(image, 15, 12);  // on the shaft: red, but for the anti-aliasing's fraction
   EXPECT_EQ(on[0], 255);
   EXPECT_LT(on[1], 64);
@@ -93,10 +87,10 @@ TEST(FlowBlend, WeighsTheRenderingOverThePicture) {
 
 TEST(FlowErrorMap, ColoursTheErrorByItsScaleAndGreysOutUnscoredPixels) {
   constexpr int w = 200, h = 120;
-  FlowField truth = uniform(w, h, 0, 0);
+  FlowField truth = constant_field(w, h, 0, 0);
   truth.valid.assign(truth.pixel_count(), 1);
   truth.valid[static_cast<std::size_t>(60) * w + 10] = 0;
-  FlowField predicted = uniform(w, h, 0, 0);
+  FlowField predicted = constant_field(w, h, 0, 0);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w / 2; ++x) predicted.uv[2 * (static_cast<std::size_t>(y) * w + x)] = 2.0f;  // error 2 px
   }
@@ -115,12 +109,12 @@ TEST(FlowErrorMap, ColoursTheErrorByItsScaleAndGreysOutUnscoredPixels) {
   const Rgb8 top = pixel(map, bar_x, upper + 1), low = pixel(map, bar_x, bottom - 2);
   EXPECT_GT(top[0] + top[1], 400) << "the bar's top";
   EXPECT_LT(low[0] + low[1] + low[2], 60) << "the bar's bottom";
-  EXPECT_THROW(error_map(predicted, uniform(w, h + 1, 0, 0)), std::invalid_argument);
+  EXPECT_THROW(error_map(predicted, constant_field(w, h + 1, 0, 0)), std::invalid_argument);
 }
 
 TEST(FlowErrorMap, ANonFinitePredictionIsTheLargestError) {
-  FlowField truth = uniform(100, 80, 0, 0);
-  FlowField predicted = uniform(100, 80, 1, 0);
+  FlowField truth = constant_field(100, 80, 0, 0);
+  FlowField predicted = constant_field(100, 80, 1, 0);
   predicted.uv[2 * (40 * 100 + 20)] = std::numeric_limits<float>::quiet_NaN();
   const RgbImage map = error_map(predicted, truth, 1.0);
   EXPECT_EQ(pixel(map, 20, 40), pixel(map, 30, 40)) << "NaN is drawn as the scale's end, like a 1 px error here";

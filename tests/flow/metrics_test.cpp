@@ -5,21 +5,16 @@
 #include <cmath>
 #include <limits>
 
+#include "test_util.hpp"
+
 namespace neuflow::flow {
 namespace {
 
-FlowField constant(int w, int h, float u, float v) {
-  FlowField f(w, h);
-  for (std::size_t i = 0; i < f.pixel_count(); ++i) {
-    f.uv[2 * i] = u;
-    f.uv[2 * i + 1] = v;
-  }
-  return f;
-}
+using test::constant_field;
 
 TEST(Metrics, ConstantOffsetThreeFourGivesEpeFive) {
-  const FlowField gt = constant(8, 6, 1.f, -2.f);
-  const FlowField pred = constant(8, 6, 4.f, 2.f);
+  const FlowField gt = constant_field(8, 6, 1.f, -2.f);
+  const FlowField pred = constant_field(8, 6, 4.f, 2.f);
   const FlowMetrics m = compute_metrics(pred, gt);
   EXPECT_EQ(m.epe, 5.0);
   EXPECT_EQ(m.fl_all, 1.0);  // 5 > 3 and 5 > 5% of |(1, -2)|
@@ -31,7 +26,7 @@ TEST(Metrics, ConstantOffsetThreeFourGivesEpeFive) {
 }
 
 TEST(Metrics, IdenticalFieldsArePerfect) {
-  const FlowField gt = constant(3, 3, 7.f, 1.f);
+  const FlowField gt = constant_field(3, 3, 7.f, 1.f);
   const FlowMetrics m = compute_metrics(gt, gt);
   EXPECT_EQ(m.epe, 0.0);
   EXPECT_EQ(m.fl_all, 0.0);
@@ -62,8 +57,8 @@ TEST(Metrics, FlAllNeedsBothThreePixelsAndFivePercent) {
 }
 
 TEST(Metrics, OnlyGroundTruthValidPixelsCount) {
-  FlowField gt = constant(4, 1, 0.f, 0.f);
-  FlowField pred = constant(4, 1, 0.f, 0.f);
+  FlowField gt = constant_field(4, 1, 0.f, 0.f);
+  FlowField pred = constant_field(4, 1, 0.f, 0.f);
   gt.valid = {1, 0, 1, 0};
   pred.u(1, 0) = 1000.f;  // invalid in gt: ignored
   pred.u(2, 0) = 2.f;
@@ -75,8 +70,8 @@ TEST(Metrics, OnlyGroundTruthValidPixelsCount) {
 }
 
 TEST(Metrics, PredictedMaskIsIgnoredUnlessAsked) {
-  const FlowField gt = constant(2, 1, 0.f, 0.f);
-  FlowField pred = constant(2, 1, 0.f, 0.f);
+  const FlowField gt = constant_field(2, 1, 0.f, 0.f);
+  FlowField pred = constant_field(2, 1, 0.f, 0.f);
   pred.u(1, 0) = 4.f;
   pred.valid = {1, 0};
   EXPECT_EQ(compute_metrics(pred, gt).epe, 2.0);
@@ -89,7 +84,7 @@ TEST(Metrics, PredictedMaskIsIgnoredUnlessAsked) {
 }
 
 TEST(Metrics, NoValidPixelGivesNaNRatios) {
-  FlowField gt = constant(2, 2, 0.f, 0.f);
+  FlowField gt = constant_field(2, 2, 0.f, 0.f);
   gt.valid.assign(4, 0);
   const FlowMetrics m = compute_metrics(gt, gt);
   EXPECT_EQ(m.valid_pixels, 0u);
@@ -99,8 +94,8 @@ TEST(Metrics, NoValidPixelGivesNaNRatios) {
 }
 
 TEST(Metrics, NonFinitePredictionIsAnInfiniteError) {
-  const FlowField gt = constant(2, 1, 0.f, 0.f);
-  FlowField pred = constant(2, 1, 0.f, 0.f);
+  const FlowField gt = constant_field(2, 1, 0.f, 0.f);
+  FlowField pred = constant_field(2, 1, 0.f, 0.f);
   pred.v(0, 0) = std::numeric_limits<float>::quiet_NaN();
   const FlowMetrics m = compute_metrics(pred, gt);
   EXPECT_TRUE(std::isinf(m.epe));
@@ -122,8 +117,8 @@ TEST(Metrics, SizeMismatchIsAClearError) {
 
 // Pooled counts give the measures of the pixels together: the same as one field holding both.
 TEST(Metrics, PooledCountsEqualTheMetricsOfTheFieldsTogether) {
-  const FlowField gt_a = constant(4, 2, 1.f, 0.f), pred_a = constant(4, 2, 4.f, 4.f);   // error 5
-  const FlowField gt_b = constant(2, 2, 0.f, 0.f), pred_b = constant(2, 2, 0.5f, 0.f);  // error 0.5
+  const FlowField gt_a = constant_field(4, 2, 1.f, 0.f), pred_a = constant_field(4, 2, 4.f, 4.f);   // error 5
+  const FlowField gt_b = constant_field(2, 2, 0.f, 0.f), pred_b = constant_field(2, 2, 0.5f, 0.f);  // error 0.5
   MetricCounts pooled = compute_metrics(pred_a, gt_a).counts;
   pooled += compute_metrics(pred_b, gt_b).counts;
   FlowField gt_ab(12, 1), pred_ab(12, 1);

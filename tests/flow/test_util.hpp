@@ -57,6 +57,16 @@ inline FlowField make_field(int width, int height, bool with_mask = false) {
   return f;
 }
 
+// A field of one vector (u, v) everywhere, without a mask.
+inline FlowField constant_field(int width, int height, float u, float v) {
+  FlowField f(width, height);
+  for (std::size_t i = 0; i < f.pixel_count(); ++i) {
+    f.uv[2 * i] = u;
+    f.uv[2 * i + 1] = v;
+  }
+  return f;
+}
+
 // Runs fn, expecting a FlowFileError of the given kind whose message names path and
 // contains `fragment`.
 template <class Fn>
