@@ -45,6 +45,7 @@
 
 #include "elements.hpp"
 #include "neuflow/flow/arrows.hpp"
+#include "neuflow/flow/figures.hpp"
 #include "neuflow/flow/flow_field.hpp"
 #include "neuflow/flow/visualize.hpp"
 #include "neuflow/gst/flow_meta.h"
@@ -88,9 +89,9 @@ enum {
 
 #define DEFAULT_PROP_MAX_FLOW 20.0
 #define DEFAULT_PROP_MODE GST_NEUFLOW_VIZ_MODE_OVERLAY /* what a live view over the video wants */
-#define DEFAULT_PROP_ALPHA 0.6
+#define DEFAULT_PROP_ALPHA neuflow::flow::kOverlayAlpha
 #define DEFAULT_PROP_ARROWS FALSE
-#define DEFAULT_PROP_ARROW_SPACING 24u
+#define DEFAULT_PROP_ARROW_SPACING static_cast<guint>(neuflow::flow::kArrowSpacing)
 #define DEFAULT_PROP_ARROW_COLOR 0xff000000u /* opaque black, 0xAARRGGBB */
 #define DEFAULT_PROP_ARROW_SCALE 0.0         /* auto: a vector of max-flow pixels is arrow-spacing long */
 #define MAX_ARROW_SCALE 1000.0

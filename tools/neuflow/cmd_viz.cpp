@@ -28,9 +28,9 @@ struct VizOptions {
   bool fixed_max = false;
   bool key = false;
   bool arrows = false;
-  int arrow_spacing = 24;  // the element's default
+  int arrow_spacing = flow::kArrowSpacing;
   std::string overlay;     // the frame to draw over; empty: the rendering alone
-  double alpha = 0.6;      // the element's default
+  double alpha = flow::kOverlayAlpha;
 };
 
 // The frame the flow is drawn over, as RGB, at the flow's size.

@@ -274,15 +274,12 @@ flow::RgbImage rgb_of(const Frame& frame) {
   return image;
 }
 
-// The opacity of the colours over the frame: the neuflowviz element's default.
-constexpr double kOverlayAlpha = 0.6;
-
 void Conversion::render(const flow::FlowField& field, const Frame& from, bool write_png) {
   if (settings_.viz == VizMode::none || (settings_.viz == VizMode::png && !write_png)) return;
   flow::VisualizeOptions options;
   options.max_flow = settings_.max_flow;
   flow::RgbImage image = flow::visualize_flow(field, options).image;
-  if (settings_.viz_look == VizLook::overlay) image = flow::blend(rgb_of(from), image, kOverlayAlpha);
+  if (settings_.viz_look == VizLook::overlay) image = flow::blend(rgb_of(from), image, flow::kOverlayAlpha);
   if (settings_.viz == VizMode::png) {
     flow::write_rgb_png(image, dir_ / "viz" / (from.output_stem + ".png"));
     return;

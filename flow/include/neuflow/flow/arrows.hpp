@@ -9,6 +9,9 @@
 
 namespace neuflow::flow {
 
+// Pixels between arrows by default: the element's arrow-spacing and `neuflow viz`'s.
+inline constexpr int kArrowSpacing = 24;
+
 // The arrows' coverage, 0 (none) to 255, over a width × height picture, row-major: each
 // vector times `scale`, at most `max_length` pixels long (longer ones are shortened), clipped
 // to the picture; a vector under a pixel long, or not finite, marks just its anchor.

@@ -21,6 +21,10 @@ void draw_key(RgbImage& image, double max_flow);
 void draw_arrows(RgbImage& image, const FlowField& field, int spacing, double scale, double max_length,
                  Rgb8 colour = {0, 0, 0});
 
+// The opacity of the colours over a video frame wherever a default is needed: the neuflowviz
+// element's alpha, `neuflow viz --overlay`'s and `convert --viz-mode overlay`'s.
+inline constexpr double kOverlayAlpha = 0.6;
+
 // `over` blended onto `under` with opacity `alpha` (0: under only, 1: over only). Throws
 // std::invalid_argument when the sizes differ or alpha is outside [0, 1].
 RgbImage blend(const RgbImage& under, const RgbImage& over, double alpha);
