@@ -29,7 +29,7 @@ struct VizOptions {
   bool key = false;
   bool arrows = false;
   int arrow_spacing = flow::kArrowSpacing;
-  std::string overlay;     // the frame to draw over; empty: the rendering alone
+  std::string overlay;  // the frame to draw over; empty: the rendering alone
   double alpha = flow::kOverlayAlpha;
 };
 
