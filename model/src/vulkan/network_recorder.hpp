@@ -123,22 +123,22 @@ class VulkanNetwork::Recorder {
   // S's push constants are its params header's struct (ShaderParams), so recording a shader with
   // another's parameters does not compile.
   template <Shader S>
-  void dispatch(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, const Work& work,
-                uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
+  void dispatch(std::array<const Buffer*, kShaderBindings> bindings, const typename ShaderParams<S>::type& push,
+                const Work& work, uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
     record_dispatch(S, bindings, &push, sizeof push, work, {gx, gy, gz});
   }
 
   // A product (conv2d, matmul or winograd_gemm) on the kernels the network runs its products
   // on (product_kernels.hpp): every variant takes the scalar shader's parameters and grid.
   template <Shader S>
-  void product(std::array<const Buffer*, 4> bindings, const typename ShaderParams<S>::type& push, const Work& work,
-               uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
+  void product(std::array<const Buffer*, kShaderBindings> bindings, const typename ShaderParams<S>::type& push,
+               const Work& work, uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
     record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work, {gx, gy, gz});
   }
 
-  void record_dispatch(Shader shader, std::array<const Buffer*, 4> bindings, const void* push, std::size_t bytes,
-                       const Work& work, std::array<uint32_t, 3> grid) {
-    std::array<VkBuffer, 4> handles{};
+  void record_dispatch(Shader shader, std::array<const Buffer*, kShaderBindings> bindings, const void* push,
+                       std::size_t bytes, const Work& work, std::array<uint32_t, 3> grid) {
+    std::array<VkBuffer, kShaderBindings> handles{};
     std::vector<VkBuffer> reads, writes;
     const auto& access = shader_info(shader).bindings;
     for (std::size_t i = 0; i < handles.size(); ++i) {

@@ -82,11 +82,13 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
     throw BackendError(BackendError::Kind::unavailable, label + ": supports only Vulkan 1.0; the shaders need 1.1");
   }
   if (props.limits.maxComputeWorkGroupInvocations < 256 || props.limits.maxComputeWorkGroupSize[0] < 256 ||
-      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 16384) {
+      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 16384 ||
+      props.limits.maxPerStageDescriptorStorageBuffers < kShaderBindings) {
     throw BackendError(BackendError::Kind::unavailable,
                        label +
                            ": compute workgroups are too small for the shaders (they need 256 invocations and "
-                           "16 KiB of shared memory, Vulkan's minimum)");
+                           "16 KiB of shared memory, Vulkan's minimum, and " +
+                           std::to_string(kShaderBindings) + " storage buffers a dispatch)");
   }
   const std::lock_guard lock(mutex);
   if (auto device = opened[index].lock(); device && !device->lost_) return device;

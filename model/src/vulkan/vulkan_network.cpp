@@ -99,7 +99,7 @@ void VulkanNetwork::load(const void* device_memory, std::size_t count, float* va
   }
 }
 
-VkDescriptorSet VulkanNetwork::descriptor_set(const std::array<VkBuffer, 4>& buffers) {
+VkDescriptorSet VulkanNetwork::descriptor_set(const std::array<VkBuffer, kShaderBindings>& buffers) {
   if (auto it = descriptor_sets_.find(buffers); it != descriptor_sets_.end()) return it->second;
   VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   alloc.descriptorSetCount = 1;
@@ -125,8 +125,8 @@ VkDescriptorSet VulkanNetwork::descriptor_set(const std::array<VkBuffer, 4>& buf
     r = vkAllocateDescriptorSets(device_.handle(), &alloc, &set);
   }
   device_.check(r, "vkAllocateDescriptorSets");
-  std::array<VkDescriptorBufferInfo, 4> infos{};
-  std::array<VkWriteDescriptorSet, 4> writes{};
+  std::array<VkDescriptorBufferInfo, kShaderBindings> infos{};
+  std::array<VkWriteDescriptorSet, kShaderBindings> writes{};
   for (std::size_t i = 0; i < buffers.size(); ++i) {
     infos[i] = {buffers[i], 0, VK_WHOLE_SIZE};
     writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};

@@ -143,7 +143,7 @@ class VulkanNetwork {
   void read_flow(const Transfer& t, Tensor& out);
   void require_idle(const char* call) const;
   static std::string encode_key(const FrameLayout* frame);
-  VkDescriptorSet descriptor_set(const std::array<VkBuffer, 4>& buffers);
+  VkDescriptorSet descriptor_set(const std::array<VkBuffer, kShaderBindings>& buffers);
   void initialise_constants();
   void release_handles();
   // Host values to and from the device's storage type.
@@ -176,7 +176,7 @@ class VulkanNetwork {
 
   VkCommandPool pool_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorPool> descriptor_pools_;
-  std::map<std::array<VkBuffer, 4>, VkDescriptorSet> descriptor_sets_;
+  std::map<std::array<VkBuffer, kShaderBindings>, VkDescriptorSet> descriptor_sets_;
   std::map<std::string, Pass> command_buffers_;
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   std::vector<uint64_t> timestamp_values_;

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <variant>
+#include <vector>
 
 #include "vulkan/network_recorder.hpp"
 #include "vulkan/one_shot_commands.hpp"
@@ -14,8 +16,70 @@
 
 namespace neuflow::model::vulkan {
 
+namespace {
+
+// Ops recorded as part of another's dispatch, which saves a dispatch and a barrier each:
+// - a refinement step's update, with the next step's correlation where only stage ends lie
+//   between them (nothing else reads or writes the flow, the update or the step input there);
+//   an observed pass keeps them apart, its observer reading each step's hidden state as the step
+//   ends;
+// - a folded BatchNorm (ChannelAffine) on a LayerNorm's output, in that LayerNorm's dispatch,
+//   where no op between them touches the tensor.
+struct Fusions {
+  std::vector<bool> absorbed;
+  std::vector<const graph::RefineUpdate*> update_first;                 // of a correlation
+  std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;  // of a LayerNorm
+};
+
+bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
+  const graph::Accesses a = std::visit([](const auto& o) { return o.accesses(); }, op);
+  const auto is = [&](const graph::Slice& s) { return s.tensor == tensor; };
+  return std::any_of(a.reads.begin(), a.reads.end(), is) || std::any_of(a.writes.begin(), a.writes.end(), is);
+}
+
+Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, bool observing) {
+  Fusions f{std::vector<bool>(ops.size()), std::vector<const graph::RefineUpdate*>(ops.size()),
+            std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size())};
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    if (const auto* update = std::get_if<graph::RefineUpdate>(&ops[i].op); update && !observing) {
+      std::size_t j = i + 1;
+      while (j < ops.size() && std::holds_alternative<graph::StageEnd>(ops[j].op)) ++j;
+      const auto* corr = j < ops.size() ? std::get_if<graph::LocalCorrelation>(&ops[j].op) : nullptr;
+      if (corr && corr->flow.tensor == update->flow.tensor && corr->out.tensor == update->hidden.tensor) {
+        f.absorbed[i] = true;
+        f.update_first[j] = update;
+      }
+    } else if (const auto* affine = std::get_if<graph::ChannelAffine<DeviceTensor>>(&ops[i].op)) {
+      for (std::size_t k = i; k-- > 0;) {
+        if (!touches(ops[k].op, affine->inout.tensor)) continue;
+        const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&ops[k].op);
+        if (norm && norm->out.tensor == affine->inout.tensor && norm->out.channel == affine->inout.channel &&
+            norm->out.c == affine->inout.c && !f.affine_after[k]) {
+          f.absorbed[i] = true;
+          f.affine_after[k] = affine;
+        }
+        break;
+      }
+    }
+  }
+  return f;
+}
+
+}  // namespace
+
 void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) {
-  for (const auto& node : ops) std::visit([&](const auto& o) { record_op(r, o); }, node.op);
+  const Fusions f = find_fusions(ops, r.observing());
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    if (f.absorbed[i]) continue;
+    const auto& op = ops[i].op;
+    if (f.update_first[i]) {
+      record_op(r, std::get<graph::LocalCorrelation>(op), *f.update_first[i]);
+    } else if (f.affine_after[i]) {
+      record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);
+    } else {
+      std::visit([&](const auto& o) { record_op(r, o); }, op);
+    }
+  }
 }
 
 void VulkanNetwork::record_encode(Recorder& r, int slot, const FrameLayout* frame) {

@@ -2,7 +2,7 @@
 
 namespace neuflow::model::vulkan {
 
-void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op) {
+void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op, const graph::ChannelAffine<DeviceTensor>* then) {
   const View in = r.view(op.in), out = r.view(op.out);
   const View residual = op.residual ? r.view(*op.residual) : View{};
   const int tokens = in.h * in.w;
@@ -12,8 +12,10 @@ void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op) {
                           out.offset(),
                           op.residual ? residual.offset() : -1,
                           op.weights->gamma.offset,
-                          op.weights->beta.offset};
-  const long long read = in.count() + 2LL * in.c + (op.residual ? out.count() : 0);
+                          op.weights->beta.offset,
+                          then ? then->scale->offset : -1,
+                          then ? then->shift->offset : -1};
+  const long long read = in.count() + (then ? 4LL : 2LL) * in.c + (op.residual ? out.count() : 0);
   r.dispatch<Shader::layer_norm>({&r.weights(), in.buffer, out.buffer, residual.buffer}, p,
                                  {r.bytes(read), r.bytes(out.count()), 0}, groups(tokens, 16));
 }

@@ -14,13 +14,17 @@ void record_op(Recorder& r, const graph::AvgPool2x& op);
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::Attention& op);
-void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op);
+// `then`: a folded BatchNorm applied to the output in the same dispatch (or nullptr).
+void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op,
+               const graph::ChannelAffine<DeviceTensor>* then = nullptr);
 void record_op(Recorder& r, const graph::ChannelAffine<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::GlobalMatching& op);
 void record_op(Recorder& r, const graph::Resample& op);
 void record_op(Recorder& r, const graph::Copy& op);
 void record_op(Recorder& r, const graph::Zero& op);
 void record_op(Recorder& r, const graph::LocalCorrelation& op);
+// The correlation with the previous refinement step's update applied first (one dispatch).
+void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::RefineUpdate& previous);
 void record_op(Recorder& r, const graph::RefineUpdate& op);
 void record_op(Recorder& r, const graph::ConvexUpsample& op);
 void record_op(Recorder& r, const graph::Output& op);

@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #include "precision.glsl"
 // LayerNorm over the channels of each token of a planar [dim][tokens] tensor (eps 1e-5),
-// optionally added to a residual: out = residual + LN(x). A workgroup takes a block of 16
+// optionally added to a residual: out = residual + LN(x), optionally followed by a folded
+// BatchNorm (out · scale[c] + shift[c], the ChannelAffine op recorded into this dispatch). A workgroup takes a block of 16
 // tokens, 16 invocations per token each summing every 16th channel, the partial sums reduced in
 // workgroup memory: 16 times the workgroups of one invocation per token (112 rather than 7 at
 // 1792 tokens), with adjacent invocations still reading adjacent tokens. Two passes (mean, then
@@ -56,6 +57,7 @@ void main() {
     for (int c = lane; c < p.dim; c += LANES) {
       float o = (float(x[p.x_off + c * p.tokens + t]) - mean) * inv * float(w[p.gamma_off + c]) + float(w[p.beta_off + c]);
       if (p.res_off >= 0) o += float(res[p.res_off + c * p.tokens + t]);
+      if (p.scale_off >= 0) o = o * float(w[p.scale_off + c]) + float(w[p.shift_off + c]);
       dst[p.out_off + c * p.tokens + t] = VALUE(o);
     }
   }

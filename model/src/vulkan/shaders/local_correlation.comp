@@ -8,11 +8,20 @@
 // A workgroup takes 16 pixels, 10 invocations each: invocation row j sums the 10 dot products
 // of neighbour row j (10 live accumulators, not 100), the rows meet in workgroup memory, and
 // rows 0-8 then blend and write the window's row j for their pixel.
+// With APPLY_UPDATE it is also the end of the refinement's previous step (refine_update.comp's
+// arithmetic, in the same dispatch): the flow is the stored flow plus conv3's delta, written
+// back (and into the step input's flow channels) once every invocation of the block has read
+// it; the clamped hidden state goes into the step input's hidden channels.
 layout(local_size_x = 16, local_size_y = 10) in;
 layout(std430, binding = 0) readonly buffer F0 { VALUE f0[]; };
 layout(std430, binding = 1) readonly buffer F1 { VALUE f1[]; };
 layout(std430, binding = 2) buffer Out { VALUE dst[]; };
+#ifdef APPLY_UPDATE
+layout(std430, binding = 3) buffer Flow { VALUE flow[]; };
+layout(std430, binding = 4) readonly buffer Update { VALUE update[]; };  // conv3's [delta 2, hidden 64]
+#else
 layout(std430, binding = 3) readonly buffer Flow { VALUE flow[]; };
+#endif
 #include "params/local_correlation_params.h"
 
 const int R = 4, WIN = 9, N = 10, PIXELS = 16;
@@ -28,10 +37,20 @@ void main() {
     float ax = 0.0, ay = 0.0;
     float d[N];
     for (int i = 0; i < N; ++i) d[i] = 0.0;
+    VALUE fx = VALUE(0.0), fy = VALUE(0.0);
     if (pix < plane) {
       const int y = pix / p.w, x = pix - y * p.w;
-      const float px = float(x) + float(flow[p.flow_off + pix]);
-      const float py = float(y) + float(flow[p.flow_off + plane + pix]);
+      fx = flow[p.flow_off + pix];
+      fy = flow[p.flow_off + plane + pix];
+#ifdef APPLY_UPDATE
+      fx = VALUE(float(fx) + float(update[p.update_off + pix]));
+      fy = VALUE(float(fy) + float(update[p.update_off + plane + pix]));
+      for (int c = j; c < 64; c += N) {
+        dst[p.hidden_off + c * plane + pix] = VALUE(clamp(float(update[p.update_off + (2 + c) * plane + pix]), -4.0, 4.0));
+      }
+#endif
+      const float px = float(x) + float(fx);
+      const float py = float(y) + float(fy);
       if (abs(px) < 1e6 && abs(py) < 1e6) {  // far outside (or not a number): all zero
         const float fx0 = floor(px), fy0 = floor(py);
         ax = px - fx0;
@@ -51,6 +70,15 @@ void main() {
     }
     for (int i = 0; i < N; ++i) sums[j][i][lx] = d[i];
     barrier();
+#ifdef APPLY_UPDATE
+    // Every invocation of this pixel has read its flow (before the barrier).
+    if (pix < plane && j == 0) {
+      flow[p.flow_off + pix] = fx;
+      flow[p.flow_off + plane + pix] = fy;
+      dst[p.flow_copy_off + pix] = fx;
+      dst[p.flow_copy_off + plane + pix] = fy;
+    }
+#endif
     if (pix < plane && j < WIN) {
       const float w00 = (1.0 - ax) * (1.0 - ay), w10 = ax * (1.0 - ay), w01 = (1.0 - ax) * ay, w11 = ax * ay;
       for (int i = 0; i < WIN; ++i) {

@@ -1,4 +1,4 @@
-// layer_norm.comp: LayerNorm over each token of a [dim][tokens] list, plus an optional residual.
+// layer_norm.comp: LayerNorm over each token of a [dim][tokens] list, plus an optional residual, then an optional folded BatchNorm.
 #ifndef NEUFLOW_SHADER_LAYER_NORM_PARAMS_H
 #define NEUFLOW_SHADER_LAYER_NORM_PARAMS_H
 #include "interface.h"
@@ -7,6 +7,7 @@ NEUFLOW_PUSH_CONSTANTS(LayerNormParams)
   int dim, tokens, x_off, out_off;
   int res_off;  // < 0: no residual
   int gamma_off, beta_off;
+  int scale_off, shift_off;  // < 0: no folded BatchNorm after it (out = out · scale + shift)
 NEUFLOW_PUSH_CONSTANTS_END
 
 #endif
