@@ -2,6 +2,8 @@
 // tensors in the regions of the graph's memory plan, persistent ones and each slot's frame
 // tensors in buffers of their own, constant channels filled once.
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -24,11 +26,13 @@ namespace {
 //   an observed pass keeps them apart, its observer reading each step's hidden state as the step
 //   ends;
 // - a folded BatchNorm (ChannelAffine) on a LayerNorm's output, in that LayerNorm's dispatch,
-//   where no op between them touches the tensor.
+//   where no op between them touches the tensor;
+// - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8.
 struct Fusions {
   std::vector<bool> absorbed;
   std::vector<const graph::RefineUpdate*> update_first;                 // of a correlation
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;  // of a LayerNorm
+  std::vector<bool> pyramid;                                            // starts here
 };
 
 bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
@@ -37,10 +41,29 @@ bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
   return std::any_of(a.reads.begin(), a.reads.end(), is) || std::any_of(a.writes.begin(), a.writes.end(), is);
 }
 
-Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, bool observing) {
+// The three poolings from ops[i] on, where they chain and the input's sides are multiples of 8.
+std::optional<std::array<const graph::AvgPool2x*, 3>> pyramid_at(const graph::OpList<DeviceTensor>& ops,
+                                                                 const graph::TensorTable& tensors, std::size_t i) {
+  std::array<const graph::AvgPool2x*, 3> pools{};
+  for (std::size_t l = 0; l < pools.size(); ++l) {
+    pools[l] = i + l < ops.size() ? std::get_if<graph::AvgPool2x>(&ops[i + l].op) : nullptr;
+    if (!pools[l] || (l > 0 && pools[l]->in.tensor != pools[l - 1]->out.tensor)) return std::nullopt;
+  }
+  const graph::TensorDesc& in = tensors.at(pools[0]->in.tensor);
+  if (in.h % 8 != 0 || in.w % 8 != 0) return std::nullopt;
+  return pools;
+}
+
+Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, bool observing) {
   Fusions f{std::vector<bool>(ops.size()), std::vector<const graph::RefineUpdate*>(ops.size()),
-            std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size())};
+            std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()), std::vector<bool>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
+    if (f.absorbed[i]) continue;
+    if (pyramid_at(ops, tensors, i)) {
+      f.pyramid[i] = true;
+      f.absorbed[i + 1] = f.absorbed[i + 2] = true;
+      continue;
+    }
     if (const auto* update = std::get_if<graph::RefineUpdate>(&ops[i].op); update && !observing) {
       std::size_t j = i + 1;
       while (j < ops.size() && std::holds_alternative<graph::StageEnd>(ops[j].op)) ++j;
@@ -68,11 +91,13 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, bool observing) {
 }  // namespace
 
 void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) {
-  const Fusions f = find_fusions(ops, r.observing());
+  const Fusions f = find_fusions(ops, graph_.tensors, r.observing());
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (f.absorbed[i]) continue;
     const auto& op = ops[i].op;
-    if (f.update_first[i]) {
+    if (f.pyramid[i]) {
+      record_op(r, *pyramid_at(ops, graph_.tensors, i));
+    } else if (f.update_first[i]) {
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.update_first[i]);
     } else if (f.affine_after[i]) {
       record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);

@@ -1,6 +1,8 @@
 #pragma once
 // Each graph op as Vulkan commands, one file per op (ncnn's layer/vulkan/ habit): a new kernel
 // for an op replaces that op's file, and a new op adds one file here and one in the CPU's.
+#include <array>
+
 #include "graph/ops.hpp"
 #include "vulkan/device_weights.hpp"
 #include "vulkan/network_recorder.hpp"
@@ -11,6 +13,8 @@ using Recorder = VulkanNetwork::Recorder;
 
 void record_op(Recorder& r, const graph::FrameInput& op);
 void record_op(Recorder& r, const graph::AvgPool2x& op);
+// Three poolings in a chain, of an input whose sides are multiples of 8, in one dispatch.
+void record_op(Recorder& r, const std::array<const graph::AvgPool2x*, 3>& ops);
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::Attention& op);
