@@ -52,35 +52,44 @@ class Builder {
     conv(w.conv2, layer + ".conv2", all(mid), out, 1, 1, Activation::leaky_relu);
   }
 
-  // One cross-attention layer for both frames: each frame's tokens attend to the other's. Each
-  // frame's tokens are projected once into q, k and v (qkv_proj, q already scaled by
-  // 1/sqrt(192)): its own queries and the other frame's keys and values.
-  void attention_layer(const BasicAttentionLayerWeights<T>& w, const std::string& layer,
-                       std::array<TensorId, 2> sources, std::array<TensorId, 2> outs) {
-    std::array<TensorId, 2> qkv{};
-    for (std::size_t f = 0; f < 2; ++f) {
-      qkv[f] = like(layer + ".frame" + std::to_string(f) + ".qkv", 3 * kFeatureChannels, sources[f]);
-      linear(w.qkv_proj, layer + ".qkv_proj", all(sources[f]), all(qkv[f]));
-    }
-    for (std::size_t f = 0; f < 2; ++f) {
-      const std::string at = layer + ".frame" + std::to_string(f);
-      const TensorId source = sources[f], other = qkv[1 - f];
-      const TensorId message = like(at + ".message", kFeatureChannels, source);
-      emit(Attention{all(qkv[f]).channels(0, kFeatureChannels), all(other).channels(kFeatureChannels, kFeatureChannels),
-                     all(other).channels(2 * kFeatureChannels, kFeatureChannels), all(message), scores(), block_rows_});
-      const TensorId merged = like(at + ".merge", kFeatureChannels, source);
-      linear(w.merge, layer + ".merge", all(message), all(merged));
-      // The MLP's input is concat[source, LayerNorm1(merged)].
-      const TensorId mlp_in = like(at + ".mlp_input", 2 * kFeatureChannels, source);
-      emit(LayerNorm<T>{&w.norm1, layer + ".norm1", all(merged),
-                        all(mlp_in).channels(kFeatureChannels, kFeatureChannels), std::nullopt});
-      emit(Copy{all(source), all(mlp_in).channels(0, kFeatureChannels)});
-      const TensorId hidden = like(at + ".mlp.0", 2 * kFeatureChannels, source);
-      linear(w.mlp0, layer + ".mlp.0", all(mlp_in), all(hidden), Activation::gelu);
-      const TensorId mlp_out = like(at + ".mlp.2", kFeatureChannels, source);
-      linear(w.mlp2, layer + ".mlp.2", all(hidden), all(mlp_out));
-      emit(LayerNorm<T>{&w.norm2, layer + ".norm2", all(mlp_out), all(outs[f]), all(source)});
-    }
+  // One cross-attention layer on `source`, which holds both frames' tokens (frame 0's rows above
+  // frame 1's): each frame's tokens attend to the other's. Every op but the attention is
+  // token-wise, so it runs both frames at once. The tokens are projected once into q, k and v
+  // (qkv_proj, q already scaled by 1/sqrt(192)): each frame's queries meet the other frame's
+  // keys and values.
+  void attention_layer(const BasicAttentionLayerWeights<T>& w, const std::string& layer, TensorId source,
+                       TensorId out) {
+    const TensorId qkv = like(layer + ".qkv", 3 * kFeatureChannels, source);
+    linear(w.qkv_proj, layer + ".qkv_proj", all(source), all(qkv));
+    const TensorId message = like(layer + ".message", kFeatureChannels, source);
+    emit(Attention{all(qkv).channels(0, kFeatureChannels), all(qkv).channels(kFeatureChannels, kFeatureChannels),
+                   all(qkv).channels(2 * kFeatureChannels, kFeatureChannels), all(message), scores(), block_rows_,
+                   true});
+    const TensorId merged = like(layer + ".merge", kFeatureChannels, source);
+    linear(w.merge, layer + ".merge", all(message), all(merged));
+    // The MLP's input is concat[source, LayerNorm1(merged)].
+    const TensorId mlp_in = like(layer + ".mlp_input", 2 * kFeatureChannels, source);
+    emit(LayerNorm<T>{&w.norm1, layer + ".norm1", all(merged), all(mlp_in).channels(kFeatureChannels, kFeatureChannels),
+                      std::nullopt});
+    emit(Copy{all(source), all(mlp_in).channels(0, kFeatureChannels)});
+    const TensorId hidden = like(layer + ".mlp.0", 2 * kFeatureChannels, source);
+    linear(w.mlp0, layer + ".mlp.0", all(mlp_in), all(hidden), Activation::gelu);
+    const TensorId mlp_out = like(layer + ".mlp.2", kFeatureChannels, source);
+    linear(w.mlp2, layer + ".mlp.2", all(hidden), all(mlp_out));
+    emit(LayerNorm<T>{&w.norm2, layer + ".norm2", all(mlp_out), all(out), all(source)});
+  }
+
+  // Both frames' `c` channels in one tensor of twice the rows, frame 0's above frame 1's.
+  TensorId stack_frames(std::string name, std::array<Slice, 2> frames) {
+    const TensorDesc& d = g_.tensors.at(frames[0].tensor);
+    const int h = d.h, w = d.w, c = frames[0].c;
+    const TensorId both = tensor(std::move(name), c, 2 * h, w);
+    for (int f = 0; f < 2; ++f) emit(CopyRows{frames[static_cast<std::size_t>(f)], all(both), 0, f * h, h});
+    return both;
+  }
+  void unstack_frames(TensorId both, std::array<Slice, 2> frames) {
+    const int h = g_.tensors.at(frames[0].tensor).h;
+    for (int f = 0; f < 2; ++f) emit(CopyRows{all(both), frames[static_cast<std::size_t>(f)], f * h, 0, h});
   }
 
   // `iterations` refinement steps of `flow` at its scale, from the pair's features and the
@@ -219,17 +228,17 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
                   {{str(stage::backbone_s8), 0, b.all(first.f8)}, {str(stage::backbone_s8), 1, b.all(second.f8)}}});
   b.emit(StageEnd{str(stage::conv_s8), {{str(stage::conv_s8), 0, b.all(first.up)}}});
 
-  // 1/16: two cross-attention layers (the second reads the first's outputs of both frames),
-  // then the attention's BatchNorm.
-  const TensorId state0 = b.tensor("cross_attn_s16.layers.0.frame0", kFeatureChannels, h16, w16);
-  const TensorId state1 = b.tensor("cross_attn_s16.layers.0.frame1", kFeatureChannels, h16, w16);
+  // 1/16: two cross-attention layers on both frames' tokens in one tensor (the second reads the
+  // first's outputs of both frames), then the attention's BatchNorm.
+  const TensorId sources = b.stack_frames("cross_attn_s16.input", {b.all(first.f16), b.all(second.f16)});
+  const TensorId state = b.like("cross_attn_s16.layers.0", kFeatureChannels, sources);
+  const TensorId attended = b.like("cross_attn_s16.layers.1", kFeatureChannels, sources);
+  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", sources, state);
+  b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", state, attended);
+  b.emit(ChannelAffine<T>{&w.attention_norm_scale, &w.attention_norm_shift, "cross_attn_s16.norm", b.all(attended)});
   const TensorId att0 = b.tensor("cross_attn_s16.frame0", kFeatureChannels, h16, w16);
   const TensorId att1 = b.tensor("cross_attn_s16.frame1", kFeatureChannels, h16, w16);
-  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", {first.f16, second.f16}, {state0, state1});
-  b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", {state0, state1}, {att0, att1});
-  for (const TensorId a : {att0, att1}) {
-    b.emit(ChannelAffine<T>{&w.attention_norm_scale, &w.attention_norm_shift, "cross_attn_s16.norm", b.all(a)});
-  }
+  b.unstack_frames(attended, {b.all(att0), b.all(att1)});
   b.emit(StageEnd{str(stage::cross_attn_s16),
                   {{str(stage::cross_attn_s16), 0, b.all(att0)}, {str(stage::cross_attn_s16), 1, b.all(att1)}}});
   const auto context_of = [&](TensorId t) { return b.all(t).channels(0, kContextChannels); };

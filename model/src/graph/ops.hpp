@@ -58,10 +58,13 @@ struct Linear {
 
 // Attention over all tokens: out[:, i] = Σ_j softmax_j(q[:, i] · k[:, j]) v[:, j] (the scale is
 // folded into q's projection). `scores` holds a block of `block_rows` rows of it at a time.
+// With `across_frames` the tensors hold both frames' tokens (CopyRows: frame 0's rows above
+// frame 1's) and each frame's queries attend to the other frame's keys and values.
 struct Attention {
   Slice q, k, v, out;
   TensorId scores = -1;
   int block_rows = 1;
+  bool across_frames = false;
   Accesses accesses() const { return {{q, k, v}, {{scores, 0, 1}, out}}; }
 };
 
@@ -105,6 +108,15 @@ struct Resample {
 
 struct Copy {
   Slice in, out;
+  Accesses accesses() const { return {{in}, {out}}; }
+};
+
+// `rows` rows of in's channels from row `in_row` on into out's from row `out_row` (tensors of one
+// width): how both frames' tokens come into one tensor, frame 0's rows above frame 1's, so that
+// a token-wise op (Linear, LayerNorm) runs both frames at once, and how they go back.
+struct CopyRows {
+  Slice in, out;
+  int in_row = 0, out_row = 0, rows = 0;
   Accesses accesses() const { return {{in}, {out}}; }
 };
 
@@ -159,7 +171,7 @@ struct StageEnd {
 template <typename T>
 using Op =
     std::variant<FrameInput, AvgPool2x, Conv2d<T>, Linear<T>, Attention, LayerNorm<T>, ChannelAffine<T>, GlobalMatching,
-                 Resample, Copy, Zero, LocalCorrelation, RefineUpdate, ConvexUpsample, Output, StageEnd>;
+                 Resample, Copy, CopyRows, Zero, LocalCorrelation, RefineUpdate, ConvexUpsample, Output, StageEnd>;
 
 // An op in a pass. `id` names the op across the passes and the refinements' iterations: each
 // iteration repeats the same ops (same ids) on the same tensors, so a backend builds what an op

@@ -28,6 +28,7 @@ std::string describe(const Op<T>& op) {
         if constexpr (std::is_same_v<O, GlobalMatching>) return "global matching";
         if constexpr (std::is_same_v<O, Resample>) return "resample";
         if constexpr (std::is_same_v<O, Copy>) return "copy";
+        if constexpr (std::is_same_v<O, CopyRows>) return "row copy";
         if constexpr (std::is_same_v<O, Zero>) return "zero";
         if constexpr (std::is_same_v<O, LocalCorrelation>) return "local correlation";
         if constexpr (std::is_same_v<O, RefineUpdate>) return "refinement update";
@@ -114,7 +115,9 @@ class Checker {
     require(
         o.q.c == o.k.c && o.v.c == o.out.c && same_plane(o.q, o.k) && same_plane(o.k, o.v) && same_plane(o.q, o.out),
         "queries, keys, values and output of different shapes");
-    require(desc({o.scores, 0, 1}).count() >= static_cast<std::size_t>(o.block_rows) * desc(o.k).plane(),
+    const std::size_t keys = desc(o.k).plane() / (o.across_frames ? 2 : 1);
+    require(!o.across_frames || desc(o.k).h % 2 == 0, "two frames' tokens in an odd number of rows");
+    require(desc({o.scores, 0, 1}).count() >= static_cast<std::size_t>(o.block_rows) * keys,
             "a score block smaller than its rows");
   }
   void check_op(const GlobalMatching& o) {
@@ -133,6 +136,11 @@ class Checker {
   }
   void check_op(const Copy& o) {
     require(o.in.c == o.out.c && same_plane(o.in, o.out), "an output shaped unlike its input");
+  }
+  void check_op(const CopyRows& o) {
+    require(o.in.c == o.out.c && desc(o.in).w == desc(o.out).w && o.rows > 0 && o.in_row >= 0 && o.out_row >= 0 &&
+                o.in_row + o.rows <= desc(o.in).h && o.out_row + o.rows <= desc(o.out).h,
+            "rows outside its tensors, or tensors of different widths");
   }
   void check_op(const LocalCorrelation& o) {
     require(o.f0.c == o.f1.c && o.flow.c == 2 && o.out.c == kCorrChannels && same_plane(o.f0, o.out) &&

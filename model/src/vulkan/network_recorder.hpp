@@ -176,21 +176,52 @@ class VulkanNetwork::Recorder {
   }
 
   // out = softmax(alpha · qᵀ k) · vᵀ per query token (flash_attention.comp), less v at the
-  // query's own token where `subtract_own_value`.
+  // query's own token where `subtract_own_value`. `across_frames`: the tensors hold two frames'
+  // tokens (frame 0's rows above frame 1's), each frame's queries against the other's keys.
   void flash_attention(const View& q, const View& k, const View& v, const View& out, float alpha,
-                       bool subtract_own_value) {
-    const long long tokens = static_cast<long long>(q.h) * q.w;
+                       bool subtract_own_value, bool across_frames = false) {
+    const int frames = across_frames ? 2 : 1;
+    const int plane = q.h * q.w, tokens = plane / frames;
     if (q.c > kFlashAttentionMaxChannels || v.c > kFlashAttentionMaxChannels) {
       throw std::logic_error("the Vulkan attention takes at most " + std::to_string(kFlashAttentionMaxChannels) +
                              " channels");
     }
-    const FlashAttentionParams p{
-        static_cast<int>(tokens),   q.c,  v.c, q.offset(), k.offset(), v.offset(), out.offset(),
-        subtract_own_value ? 1 : 0, alpha};
-    dispatch<Shader::flash_attention>(
-        {q.buffer, k.buffer, out.buffer, v.buffer}, p,
-        {bytes(q.count() + k.count() + v.count()), bytes(out.count()), tokens * tokens * (q.c + v.c)},
-        groups(tokens, 64));
+    const FlashAttentionParams p{tokens,
+                                 q.c,
+                                 v.c,
+                                 q.offset(),
+                                 k.offset(),
+                                 v.offset(),
+                                 out.offset(),
+                                 plane,
+                                 across_frames ? tokens : 0,
+                                 across_frames ? tokens : 0,
+                                 across_frames ? -tokens : 0,
+                                 subtract_own_value ? 1 : 0,
+                                 alpha};
+    dispatch<Shader::flash_attention>({q.buffer, k.buffer, out.buffer, v.buffer}, p,
+                                      {bytes(q.count() + k.count() + v.count()), bytes(out.count()),
+                                       static_cast<long long>(frames) * tokens * tokens * (q.c + v.c)},
+                                      groups(tokens, 64), static_cast<uint32_t>(frames));
+  }
+
+  // Copies `rows` rows of each of in's channels from row `in_row` on into out's from `out_row`
+  // (tensors of one width): one copy command, a region a channel.
+  void copy_rows(const View& in, const View& out, int in_row, int out_row, int rows) {
+    const VkDeviceSize e = net_.elem_;
+    std::vector<VkBufferCopy> regions(static_cast<std::size_t>(in.c));
+    for (int c = 0; c < in.c; ++c) {
+      regions[static_cast<std::size_t>(c)] = {
+          static_cast<VkDeviceSize>(in.offset() + static_cast<long long>(c) * in.h * in.w + in_row * in.w) * e,
+          static_cast<VkDeviceSize>(out.offset() + static_cast<long long>(c) * out.h * out.w + out_row * out.w) * e,
+          static_cast<VkDeviceSize>(rows) * in.w * e};
+    }
+    order({in.buffer->handle()}, {out.buffer->handle()});
+    vkCmdCopyBuffer(commands_, in.buffer->handle(), out.buffer->handle(), static_cast<uint32_t>(regions.size()),
+                    regions.data());
+    ++work_.copies;
+    const auto n = static_cast<long long>(rows) * in.w * in.c * static_cast<long long>(e);
+    count("copy", 0, {n, n, 0});
   }
 
   // The pass's frames: the slot that holds the frame each graph::FrameRole names (-1: none).

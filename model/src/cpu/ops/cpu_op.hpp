@@ -49,6 +49,7 @@ std::unique_ptr<CpuOp> build_op(const graph::ChannelAffine<HostTensor>& op, OpBu
 std::unique_ptr<CpuOp> build_op(const graph::GlobalMatching& op, OpBuild& b);
 std::unique_ptr<CpuOp> build_op(const graph::Resample& op, OpBuild& b);
 std::unique_ptr<CpuOp> build_op(const graph::Copy& op, OpBuild& b);
+std::unique_ptr<CpuOp> build_op(const graph::CopyRows& op, OpBuild& b);
 std::unique_ptr<CpuOp> build_op(const graph::Zero& op, OpBuild& b);
 std::unique_ptr<CpuOp> build_op(const graph::LocalCorrelation& op, OpBuild& b);
 std::unique_ptr<CpuOp> build_op(const graph::RefineUpdate& op, OpBuild& b);

@@ -6,7 +6,7 @@ namespace neuflow::model::vulkan {
 // the score matrix is never written.
 void record_op(Recorder& r, const graph::Attention& op) {
   const View q = r.view(op.q), k = r.view(op.k), v = r.view(op.v), out = r.view(op.out);
-  r.flash_attention(q, k, v, out, 1.f, false);
+  r.flash_attention(q, k, v, out, 1.f, false, op.across_frames);
 }
 
 }  // namespace neuflow::model::vulkan

@@ -25,6 +25,7 @@ void record_op(Recorder& r, const graph::ChannelAffine<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::GlobalMatching& op);
 void record_op(Recorder& r, const graph::Resample& op);
 void record_op(Recorder& r, const graph::Copy& op);
+void record_op(Recorder& r, const graph::CopyRows& op);
 void record_op(Recorder& r, const graph::Zero& op);
 void record_op(Recorder& r, const graph::LocalCorrelation& op);
 // The correlation with the previous refinement step's update applied first (one dispatch).

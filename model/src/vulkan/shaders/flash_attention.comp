@@ -6,7 +6,9 @@
 // and values go through workgroup memory four tokens at a time, each score is the sum of the
 // four partial dot products, and the softmax runs online (a running maximum and sum, the
 // result rescaled when the maximum grows). Reads q, k and v once per workgroup; writes only
-// the result.
+// the result. Workgroup row y takes queries from token y · query_step and keys and values from
+// key_first + y · key_step (both frames' tokens in one tensor, each frame's queries against the
+// other's keys: 2 rows); channels are `stride` values apart.
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Q { VALUE q[]; };
 layout(std430, binding = 1) readonly buffer K { VALUE k[]; };
@@ -24,7 +26,10 @@ shared float partial[QUERIES][LANES][KEYS];
 void main() {
   const int t = int(gl_LocalInvocationID.x);
   const int query = t / LANES, lane = t % LANES;
-  const int n = p.tokens;
+  const int n = p.tokens, stride = p.stride;
+  const int frame = int(gl_WorkGroupID.y);
+  const int q_base = p.q_off + frame * p.query_step, kv_first = frame * p.key_step + p.key_first;
+  const int k_base = p.k_off + kv_first, v_base = p.v_off + kv_first;
   const int i = int(gl_WorkGroupID.x) * QUERIES + query;
   const bool in_range = i < n;
   const int q_slice = (p.dim + LANES - 1) / LANES, v_slice = (p.dv + LANES - 1) / LANES;
@@ -33,7 +38,7 @@ void main() {
 
   float qv[SLICE], acc[SLICE];
   for (int c = 0; c < SLICE; ++c) {
-    qv[c] = (in_range && c < q_count) ? p.alpha * float(q[p.q_off + (q0 + c) * n + i]) : 0.0;
+    qv[c] = (in_range && c < q_count) ? p.alpha * float(q[q_base + (q0 + c) * stride + i]) : 0.0;
     acc[c] = 0.0;
   }
   float running_max = LOWEST, running_sum = 0.0;
@@ -41,11 +46,11 @@ void main() {
   for (int j0 = 0; j0 < n; j0 += KEYS) {
     for (int e = t; e < p.dim * KEYS; e += 256) {
       const int d = e / KEYS, kk = e - d * KEYS, j = j0 + kk;
-      k_tile[d][kk] = j < n ? float(k[p.k_off + d * n + j]) : 0.0;
+      k_tile[d][kk] = j < n ? float(k[k_base + d * stride + j]) : 0.0;
     }
     for (int e = t; e < p.dv * KEYS; e += 256) {
       const int d = e / KEYS, kk = e - d * KEYS, j = j0 + kk;
-      v_tile[d][kk] = j < n ? float(v[p.v_off + d * n + j]) : 0.0;
+      v_tile[d][kk] = j < n ? float(v[v_base + d * stride + j]) : 0.0;
     }
     barrier();
     for (int kk = 0; kk < KEYS; ++kk) {
@@ -81,7 +86,7 @@ void main() {
   for (int c = 0; c < v_count; ++c) {
     const int d = v0 + c;
     float r = acc[c] * inv;
-    if (p.subtract_own_value != 0) r -= float(v[p.v_off + d * n + i]);
-    dst[p.out_off + d * n + i] = VALUE(r);
+    if (p.subtract_own_value != 0) r -= float(v[p.v_off + d * stride + frame * p.query_step + i]);
+    dst[p.out_off + frame * p.query_step + d * stride + i] = VALUE(r);
   }
 }
