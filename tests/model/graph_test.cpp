@@ -161,6 +161,27 @@ TEST(MemoryPlan, AStepsTemporariesLiveWithinTheStep) {
   }
 }
 
+// Two frames' rows copied into one tensor: the second copy, whole in channels but not in rows,
+// continues the range the first began, so nothing planned between them can take its memory.
+TEST(MemoryPlan, ARowCopyContinuesItsTensorsRange) {
+  graph::TensorTable tensors;
+  const auto frame0 = tensors.add({"frame0", 2, 4, 4});
+  const auto frame1 = tensors.add({"frame1", 2, 4, 4});
+  const auto both = tensors.add({"both", 2, 8, 4});
+  const auto other = tensors.add({"other", 2, 4, 4});
+  graph::OpList<Host> pass{{0, graph::Zero{tensors.all(frame0)}},
+                           {1, graph::Zero{tensors.all(frame1)}},
+                           {2, graph::CopyRows{tensors.all(frame0), tensors.all(both), 0, 0, 4}},
+                           {3, graph::Zero{tensors.all(other)}},
+                           {4, graph::CopyRows{tensors.all(frame1), tensors.all(both), 0, 4, 4}},
+                           {5, graph::Copy{tensors.all(other), tensors.all(frame0)}},
+                           {6, graph::Output{tensors.all(both).channels(0, 2)}}};
+  const auto ranges = graph::live_ranges<Host>(tensors, {&pass});
+  ASSERT_EQ(ranges[static_cast<std::size_t>(both)].size(), 1u);
+  EXPECT_EQ(ranges[static_cast<std::size_t>(both)][0].first, 2);
+  EXPECT_EQ(ranges[static_cast<std::size_t>(both)][0].last, 6);
+}
+
 TEST(MemoryPlan, ATensorReadBeforeItsPassWritesItIsAnError) {
   graph::TensorTable tensors;
   const auto a = tensors.add({"a", 2, 4, 4});

@@ -132,6 +132,27 @@ TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
   unsetenv("NEUFLOW_VULKAN_CONV");
 }
 
+// An unobserved pass records some ops inside others' dispatches (a refinement step's update in
+// the next step's correlation, at both scales with these iterations; the attention's BatchNorm
+// in its LayerNorm; the pyramid's three poolings in one): its flow is still the CPU's.
+TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
+  cv::Mat a, b;  // sides multiples of 8, so the pyramid is one dispatch
+  cv::resize(frames_[0], a, cv::Size(128, 96), 0, 0, cv::INTER_AREA);
+  cv::resize(frames_[1], b, cv::Size(128, 96), 0, 0, cv::INTER_AREA);
+  const Iterations iterations{2, 3};
+  FlowSession cpu(model_, {.iterations = iterations, .threads = 2, .backend = Backend::cpu});
+  FlowSession gpu(model_, {.iterations = iterations, .backend = Backend::vulkan});
+  const Errors e = compare(gpu.compute(view_of(a), view_of(b)), cpu.compute(view_of(a), view_of(b)));
+  EXPECT_LT(e.max, 1e-2);
+  EXPECT_LT(e.mean, 1e-3);
+  const auto& commands = gpu.device_work().commands;
+  const auto dispatches_of = [&](const std::string& kernel) {
+    return std::count_if(commands.begin(), commands.end(), [&](const DeviceCommand& c) { return c.kernel == kernel; });
+  };
+  EXPECT_EQ(dispatches_of("local_correlation_update"), iterations.s16 + iterations.s8 - 2);
+  EXPECT_EQ(dispatches_of("avgpool_pyramid"), 2) << "one a frame";
+}
+
 TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {
   // Smaller than the other tests' frames (→ 112×64 padded): five passes on lavapipe, where the
   // size changes nothing this test checks but its time.

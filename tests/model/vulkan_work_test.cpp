@@ -122,7 +122,7 @@ TEST_F(VulkanWork, AStreamedFrameIsCountedCommandByCommand) {
 
   // Recorded inside other dispatches: each refinement step's update in the next step's
   // correlation (only the last step of each scale keeps its own), the attention's BatchNorm in
-  // its last LayerNorms; the frame's three poolings in one.
+  // its last LayerNorm; the frame's three poolings in one.
   const auto dispatches_of = [&](const std::string& kernel) {
     return std::count_if(work.commands.begin(), work.commands.end(),
                          [&](const DeviceCommand& c) { return c.kernel == kernel; });

@@ -16,9 +16,11 @@
 
 namespace neuflow::model::graph {
 
-// What an op reads and writes.
+// What an op reads and writes. `partial_rows`: its writes may cover only some of a tensor's rows
+// (a slice names channels, not rows), so none of them starts the tensor's live range anew.
 struct Accesses {
   std::vector<Slice> reads, writes;
+  bool partial_rows = false;
 };
 
 // The pass's input frame, as the network takes it: [3][H][W] in 0..1. Where it comes from (an
@@ -117,7 +119,7 @@ struct Copy {
 struct CopyRows {
   Slice in, out;
   int in_row = 0, out_row = 0, rows = 0;
-  Accesses accesses() const { return {{in}, {out}}; }
+  Accesses accesses() const { return {{in}, {out}, true}; }
 };
 
 struct Zero {

@@ -82,13 +82,17 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
     throw BackendError(BackendError::Kind::unavailable, label + ": supports only Vulkan 1.0; the shaders need 1.1");
   }
   if (props.limits.maxComputeWorkGroupInvocations < 256 || props.limits.maxComputeWorkGroupSize[0] < 256 ||
-      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 16384 ||
-      props.limits.maxPerStageDescriptorStorageBuffers < kShaderBindings) {
+      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 16384) {
     throw BackendError(BackendError::Kind::unavailable,
                        label +
                            ": compute workgroups are too small for the shaders (they need 256 invocations and "
-                           "16 KiB of shared memory, Vulkan's minimum, and " +
-                           std::to_string(kShaderBindings) + " storage buffers a dispatch)");
+                           "16 KiB of shared memory, Vulkan's minimum)");
+  }
+  if (props.limits.maxPerStageDescriptorStorageBuffers < kShaderBindings) {
+    throw BackendError(BackendError::Kind::unavailable,
+                       label + ": a shader may bind only " +
+                           std::to_string(props.limits.maxPerStageDescriptorStorageBuffers) +
+                           " storage buffers; the shaders need " + std::to_string(kShaderBindings));
   }
   const std::lock_guard lock(mutex);
   if (auto device = opened[index].lock(); device && !device->lost_) return device;

@@ -22,9 +22,10 @@ namespace {
 
 // Ops recorded as part of another's dispatch, which saves a dispatch and a barrier each:
 // - a refinement step's update, with the next step's correlation where only stage ends lie
-//   between them (nothing else reads or writes the flow, the update or the step input there);
-//   an observed pass keeps them apart, its observer reading each step's hidden state as the step
-//   ends;
+//   between them (unobserved, a stage end reads nothing: nothing else touches the flow, the
+//   update or the step input there); an observed pass keeps them apart, its observer reading
+//   each step's hidden state as the step ends. A step's device time then includes the update of
+//   the step before;
 // - a folded BatchNorm (ChannelAffine) on a LayerNorm's output, in that LayerNorm's dispatch,
 //   where no op between them touches the tensor;
 // - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8.
@@ -68,7 +69,8 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
       std::size_t j = i + 1;
       while (j < ops.size() && std::holds_alternative<graph::StageEnd>(ops[j].op)) ++j;
       const auto* corr = j < ops.size() ? std::get_if<graph::LocalCorrelation>(&ops[j].op) : nullptr;
-      if (corr && corr->flow.tensor == update->flow.tensor && corr->out.tensor == update->hidden.tensor) {
+      if (corr && corr->flow.tensor == update->flow.tensor && corr->out.tensor == update->hidden.tensor &&
+          corr->out.tensor == update->flow_copy.tensor) {
         f.absorbed[i] = true;
         f.update_first[j] = update;
       }
@@ -96,7 +98,19 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
     if (f.absorbed[i]) continue;
     const auto& op = ops[i].op;
     if (f.pyramid[i]) {
-      record_op(r, *pyramid_at(ops, graph_.tensors, i));
+      // One dispatch writes all three levels: only where the plan gave them buffers of their own.
+      const auto pools = *pyramid_at(ops, graph_.tensors, i);
+      const std::array<const Buffer*, 4> buffers{r.view(pools[0]->in).buffer, r.view(pools[0]->out).buffer,
+                                                 r.view(pools[1]->out).buffer, r.view(pools[2]->out).buffer};
+      bool distinct = true;
+      for (std::size_t a = 0; a < buffers.size(); ++a) {
+        for (std::size_t b = a + 1; b < buffers.size(); ++b) distinct = distinct && buffers[a] != buffers[b];
+      }
+      if (distinct) {
+        record_op(r, pools);
+      } else {
+        for (const auto* pool : pools) record_op(r, *pool);
+      }
     } else if (f.update_first[i]) {
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.update_first[i]);
     } else if (f.affine_after[i]) {

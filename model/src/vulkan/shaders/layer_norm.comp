@@ -3,7 +3,8 @@
 #include "precision.glsl"
 // LayerNorm over the channels of each token of a planar [dim][tokens] tensor (eps 1e-5),
 // optionally added to a residual: out = residual + LN(x), optionally followed by a folded
-// BatchNorm (out · scale[c] + shift[c], the ChannelAffine op recorded into this dispatch). A workgroup takes a block of 16
+// BatchNorm (out · scale[c] + shift[c], the ChannelAffine op recorded into this dispatch; in
+// fp16 that rounds once where the two dispatches rounded twice). A workgroup takes a block of 16
 // tokens, 16 invocations per token each summing every 16th channel, the partial sums reduced in
 // workgroup memory: 16 times the workgroups of one invocation per token (112 rather than 7 at
 // 1792 tokens), with adjacent invocations still reading adjacent tokens. Two passes (mean, then
