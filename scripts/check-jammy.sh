@@ -138,7 +138,8 @@ say "every target built in Ubuntu 22.04 with the $preset preset ($(( $(date +%s)
 # The file pipeline against the CLI on lavapipe is left out too: the element's lavapipe tests
 # and the CLI's Vulkan failures run here, and it runs both again on more frames.
 lavapipe_repeats='NetworkReference\.EveryStageMatchesTheReference/vulkan|VulkanSession\.(StreamingGivesTheSameFlowAsPairs'
-lavapipe_repeats+='|Fp16StaysWithinItsBoundOfFp32|FramesConvertedOnTheDeviceGiveTheCpusFlow|DeviceTimestampsTimeEveryStageOfAFrame)'
+lavapipe_repeats+='|Fp16StaysWithinItsBoundOfFp32|FramesConvertedOnTheDeviceGiveTheCpusFlow|DeviceTimestampsTimeEveryStageOfAFrame'
+lavapipe_repeats+='|FusedDispatchesGiveTheCpusFlowAtBothScales)'
 lavapipe_repeats+='|VulkanSession\.EveryWayOfConvolvingGivesTheCpusFlow'
 # The device-work counts are host code: one test of them runs here, the rest repeat lavapipe runs.
 lavapipe_repeats+='|VulkanWork\.(WinogradComputesFewerMultiplyAdds|APipelinedFrameTakesOneSubmissionAndOneWait'
