@@ -134,9 +134,10 @@ TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
 
 // An unobserved pass records some ops inside others' dispatches (a refinement step's update in
 // the next step's correlation, at both scales with these iterations; the attention's BatchNorm
-// in its LayerNorm; the pyramid's three poolings in one): its flow is still the CPU's.
+// in its LayerNorm; each 8-bit frame's conversion and its pyramid's three poolings in one): its
+// flow is still the CPU's.
 TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
-  cv::Mat a, b;  // sides multiples of 8, so the pyramid is one dispatch
+  cv::Mat a, b;
   cv::resize(frames_[0], a, cv::Size(128, 96), 0, 0, cv::INTER_AREA);
   cv::resize(frames_[1], b, cv::Size(128, 96), 0, 0, cv::INTER_AREA);
   const Iterations iterations{2, 3};
@@ -150,7 +151,7 @@ TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
     return std::count_if(commands.begin(), commands.end(), [&](const DeviceCommand& c) { return c.kernel == kernel; });
   };
   EXPECT_EQ(dispatches_of("local_correlation_update"), iterations.s16 + iterations.s8 - 2);
-  EXPECT_EQ(dispatches_of("avgpool_pyramid"), 2) << "one a frame";
+  EXPECT_EQ(dispatches_of("frame_pyramid"), 2) << "one a frame";
 }
 
 TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {

@@ -28,7 +28,8 @@ namespace {
 //   the step before;
 // - a folded BatchNorm (ChannelAffine) on a LayerNorm's output, in that LayerNorm's dispatch,
 //   where no op between them touches the tensor;
-// - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8.
+// - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8,
+//   and with them the 8-bit frame's conversion into that input where the pyramid follows it.
 struct Fusions {
   std::vector<bool> absorbed;
   std::vector<const graph::RefineUpdate*> update_first;                 // of a correlation
@@ -94,22 +95,40 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
 
 void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) {
   const Fusions f = find_fusions(ops, graph_.tensors, r.observing());
+  // One dispatch writes every level of the pyramid (and the frame's input with it): only where
+  // the plan gave them buffers of their own.
+  const auto own_buffers = [&](const std::array<const graph::AvgPool2x*, 3>& pools) {
+    const std::array<const Buffer*, 4> buffers{r.view(pools[0]->in).buffer, r.view(pools[0]->out).buffer,
+                                               r.view(pools[1]->out).buffer, r.view(pools[2]->out).buffer};
+    for (std::size_t a = 0; a < buffers.size(); ++a) {
+      for (std::size_t b = a + 1; b < buffers.size(); ++b) {
+        if (buffers[a] == buffers[b]) return false;
+      }
+    }
+    return true;
+  };
+  bool pyramid_recorded = false;  // with the frame's input, just before it
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (f.absorbed[i]) continue;
     const auto& op = ops[i].op;
     if (f.pyramid[i]) {
-      // One dispatch writes all three levels: only where the plan gave them buffers of their own.
       const auto pools = *pyramid_at(ops, graph_.tensors, i);
-      const std::array<const Buffer*, 4> buffers{r.view(pools[0]->in).buffer, r.view(pools[0]->out).buffer,
-                                                 r.view(pools[1]->out).buffer, r.view(pools[2]->out).buffer};
-      bool distinct = true;
-      for (std::size_t a = 0; a < buffers.size(); ++a) {
-        for (std::size_t b = a + 1; b < buffers.size(); ++b) distinct = distinct && buffers[a] != buffers[b];
-      }
-      if (distinct) {
+      if (pyramid_recorded) {
+        pyramid_recorded = false;
+      } else if (own_buffers(pools)) {
         record_op(r, pools);
       } else {
         for (const auto* pool : pools) record_op(r, *pool);
+      }
+    } else if (const auto* frame = std::get_if<graph::FrameInput>(&op);
+               frame && r.frame_layout() && i + 1 < ops.size() && f.pyramid[i + 1]) {
+      // An 8-bit frame converted and pooled in one dispatch (frame_pyramid).
+      const auto pools = *pyramid_at(ops, graph_.tensors, i + 1);
+      pyramid_recorded = pools[0]->in.tensor == frame->out.tensor && own_buffers(pools);
+      if (pyramid_recorded) {
+        record_op(r, *frame, pools);
+      } else {
+        record_op(r, *frame);
       }
     } else if (f.update_first[i]) {
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.update_first[i]);

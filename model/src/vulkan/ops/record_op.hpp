@@ -12,6 +12,9 @@ namespace neuflow::model::vulkan {
 using Recorder = VulkanNetwork::Recorder;
 
 void record_op(Recorder& r, const graph::FrameInput& op);
+// An 8-bit frame (Recorder::frame_layout()) converted into the input and pooled three times
+// (`pyramid`, of that input) in one dispatch.
+void record_op(Recorder& r, const graph::FrameInput& op, const std::array<const graph::AvgPool2x*, 3>& pyramid);
 void record_op(Recorder& r, const graph::AvgPool2x& op);
 // Three poolings in a chain, of an input whose sides are multiples of 8, in one dispatch.
 void record_op(Recorder& r, const std::array<const graph::AvgPool2x*, 3>& ops);
