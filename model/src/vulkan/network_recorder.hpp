@@ -139,12 +139,12 @@ class VulkanNetwork::Recorder {
   void record_dispatch(Shader shader, std::array<const Buffer*, kShaderBindings> bindings, const void* push,
                        std::size_t bytes, const Work& work, std::array<uint32_t, 3> grid) {
     std::array<VkBuffer, kShaderBindings> handles{};
-    std::vector<VkBuffer> reads, writes;
+    std::vector<Span> reads, writes;
     const auto& access = shader_info(shader).bindings;
     for (std::size_t i = 0; i < handles.size(); ++i) {
       handles[i] = (bindings[i] ? *bindings[i] : net_.dummy_).handle();
-      if (access[i].reads) reads.push_back(handles[i]);
-      if (access[i].writes) writes.push_back(handles[i]);
+      if (access[i].reads) reads.push_back(whole(handles[i]));
+      if (access[i].writes) writes.push_back(whole(handles[i]));
     }
     order(reads, writes);
     VkDescriptorSet set = net_.descriptor_set(handles);
@@ -216,7 +216,12 @@ class VulkanNetwork::Recorder {
           static_cast<VkDeviceSize>(out.offset() + static_cast<long long>(c) * out.h * out.w + out_row * out.w) * e,
           static_cast<VkDeviceSize>(rows) * in.w * e};
     }
-    order({in.buffer->handle()}, {out.buffer->handle()});
+    std::vector<Span> reads, writes;
+    for (const VkBufferCopy& region : regions) {
+      reads.push_back({in.buffer->handle(), region.srcOffset, region.srcOffset + region.size});
+      writes.push_back({out.buffer->handle(), region.dstOffset, region.dstOffset + region.size});
+    }
+    order(reads, writes);
     vkCmdCopyBuffer(commands_, in.buffer->handle(), out.buffer->handle(), static_cast<uint32_t>(regions.size()),
                     regions.data());
     ++work_.copies;
@@ -287,14 +292,24 @@ class VulkanNetwork::Recorder {
     ++work_.barriers;
   }
 
-  // A barrier before the next command where it depends on one since the last barrier.
-  void order(const std::vector<VkBuffer>& reads, const std::vector<VkBuffer>& writes) {
-    const auto in = [](const std::vector<VkBuffer>& set, VkBuffer b) {
-      return std::find(set.begin(), set.end(), b) != set.end();
+  // Bytes [begin, end) of a buffer: a dispatch touches its bindings whole (the descriptors bind
+  // whole buffers), a copy only its regions.
+  struct Span {
+    VkBuffer buffer;
+    VkDeviceSize begin, end;
+  };
+  static Span whole(VkBuffer b) { return {b, 0, VK_WHOLE_SIZE}; }
+
+  // A barrier before the next command where it depends on one since the last barrier: reads
+  // bytes written since, or writes bytes read or written since.
+  void order(const std::vector<Span>& reads, const std::vector<Span>& writes) {
+    const auto in = [](const std::vector<Span>& set, const Span& s) {
+      return std::any_of(set.begin(), set.end(),
+                         [&](const Span& t) { return t.buffer == s.buffer && t.begin < s.end && s.begin < t.end; });
     };
     bool depends = after_unknown_;
-    for (VkBuffer b : reads) depends = depends || in(written_, b);
-    for (VkBuffer b : writes) depends = depends || in(written_, b) || in(read_, b);
+    for (const Span& b : reads) depends = depends || in(written_, b);
+    for (const Span& b : writes) depends = depends || in(written_, b) || in(read_, b);
     if (depends) {
       barrier();
       written_.clear();
@@ -307,7 +322,8 @@ class VulkanNetwork::Recorder {
   }
 
   void copy_region(const Buffer& src, const Buffer& dst, const VkBufferCopy& region) {
-    order({src.handle()}, {dst.handle()});
+    order({{src.handle(), region.srcOffset, region.srcOffset + region.size}},
+          {{dst.handle(), region.dstOffset, region.dstOffset + region.size}});
     vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), 1, &region);
     ++work_.copies;
     const auto n = static_cast<long long>(region.size);
@@ -337,9 +353,9 @@ class VulkanNetwork::Recorder {
   bool worked_ = false;  // commands recorded since the last timestamp
   DeviceWork work_;
   std::size_t labelled_ = 0;  // commands before this one have their stage
-  // Buffers written and read since the last barrier; after_unknown_: nothing is known of what
+  // What was written and read since the last barrier; after_unknown_: nothing is known of what
   // ran before (a recording's start), so the next command waits for all of it.
-  std::vector<VkBuffer> written_, read_;
+  std::vector<Span> written_, read_;
   bool after_unknown_ = true;
   std::array<int, 3> frames_{-1, -1, -1};
   const FrameLayout* frame_layout_ = nullptr;
