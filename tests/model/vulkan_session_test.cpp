@@ -146,12 +146,8 @@ TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
   const Errors e = compare(gpu.compute(view_of(a), view_of(b)), cpu.compute(view_of(a), view_of(b)));
   EXPECT_LT(e.max, 1e-2);
   EXPECT_LT(e.mean, 1e-3);
-  const auto& commands = gpu.device_work().commands;
-  const auto dispatches_of = [&](const std::string& kernel) {
-    return std::count_if(commands.begin(), commands.end(), [&](const DeviceCommand& c) { return c.kernel == kernel; });
-  };
-  EXPECT_EQ(dispatches_of("local_correlation_update"), iterations.s16 + iterations.s8 - 2);
-  EXPECT_EQ(dispatches_of("frame_pyramid"), 2) << "one a frame";
+  EXPECT_EQ(test::dispatches_of(gpu.device_work(), "local_correlation_update"), iterations.s16 + iterations.s8 - 2);
+  EXPECT_EQ(test::dispatches_of(gpu.device_work(), "frame_pyramid"), 2) << "one a frame";
 }
 
 TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {

@@ -123,21 +123,17 @@ TEST_F(VulkanWork, AStreamedFrameIsCountedCommandByCommand) {
   // Recorded inside other dispatches: each refinement step's update in the next step's
   // correlation (only the last step of each scale keeps its own), the attention's BatchNorm in
   // its last LayerNorm; the 8-bit frame's conversion and its three poolings in one.
-  const auto dispatches_of = [&](const std::string& kernel) {
-    return std::count_if(work.commands.begin(), work.commands.end(),
-                         [&](const DeviceCommand& c) { return c.kernel == kernel; });
-  };
   const Iterations steps;
-  EXPECT_EQ(dispatches_of("refine_update"), 2);
-  EXPECT_EQ(dispatches_of("local_correlation"), 2);
-  EXPECT_EQ(dispatches_of("local_correlation_update"), steps.s16 + steps.s8 - 2);
-  EXPECT_EQ(dispatches_of("channel_affine"), 0);
-  EXPECT_EQ(dispatches_of("frame_u8"), 0);
-  EXPECT_EQ(dispatches_of("avgpool2x"), 0);
-  EXPECT_EQ(dispatches_of("frame_pyramid"), 1);
+  EXPECT_EQ(test::dispatches_of(work, "refine_update"), 2);
+  EXPECT_EQ(test::dispatches_of(work, "local_correlation"), 2);
+  EXPECT_EQ(test::dispatches_of(work, "local_correlation_update"), steps.s16 + steps.s8 - 2);
+  EXPECT_EQ(test::dispatches_of(work, "channel_affine"), 0);
+  EXPECT_EQ(test::dispatches_of(work, "frame_u8"), 0);
+  EXPECT_EQ(test::dispatches_of(work, "avgpool2x"), 0);
+  EXPECT_EQ(test::dispatches_of(work, "frame_pyramid"), 1);
   // Each attention layer runs both frames in one dispatch (their tokens in one tensor), the
   // matching in a third.
-  EXPECT_EQ(dispatches_of("flash_attention"), 3);
+  EXPECT_EQ(test::dispatches_of(work, "flash_attention"), 3);
 }
 
 // Winograd F(4×4, 3×3) computes 36 products per 4×4 tile and channel pair where the direct

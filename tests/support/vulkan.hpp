@@ -4,9 +4,12 @@
 // expect the Khronos validation layer (NEUFLOW_VULKAN_VALIDATION=1, set by ctest) to stay quiet.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
+#include <string_view>
 
+#include "neuflow/model/device_work.hpp"
 #include "neuflow/model/gpu_devices.hpp"
 
 namespace neuflow::test {
@@ -51,6 +54,12 @@ inline bool only_software_vulkan() {
   } catch (const model::BackendError&) {
   }
   return true;
+}
+
+// How many of a pass's commands ran `kernel` (DeviceWork's command names).
+inline long dispatches_of(const model::DeviceWork& work, std::string_view kernel) {
+  return static_cast<long>(std::count_if(work.commands.begin(), work.commands.end(),
+                                         [&](const model::DeviceCommand& c) { return c.kernel == kernel; }));
 }
 
 }  // namespace neuflow::test

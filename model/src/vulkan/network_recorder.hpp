@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -216,17 +217,7 @@ class VulkanNetwork::Recorder {
           static_cast<VkDeviceSize>(out.offset() + static_cast<long long>(c) * out.h * out.w + out_row * out.w) * e,
           static_cast<VkDeviceSize>(rows) * in.w * e};
     }
-    std::vector<Span> reads, writes;
-    for (const VkBufferCopy& region : regions) {
-      reads.push_back({in.buffer->handle(), region.srcOffset, region.srcOffset + region.size});
-      writes.push_back({out.buffer->handle(), region.dstOffset, region.dstOffset + region.size});
-    }
-    order(reads, writes);
-    vkCmdCopyBuffer(commands_, in.buffer->handle(), out.buffer->handle(), static_cast<uint32_t>(regions.size()),
-                    regions.data());
-    ++work_.copies;
-    const auto n = static_cast<long long>(rows) * in.w * in.c * static_cast<long long>(e);
-    count("copy", 0, {n, n, 0});
+    copy_regions(*in.buffer, *out.buffer, regions);
   }
 
   // The pass's frames: the slot that holds the frame each graph::FrameRole names (-1: none).
@@ -322,11 +313,20 @@ class VulkanNetwork::Recorder {
   }
 
   void copy_region(const Buffer& src, const Buffer& dst, const VkBufferCopy& region) {
-    order({{src.handle(), region.srcOffset, region.srcOffset + region.size}},
-          {{dst.handle(), region.dstOffset, region.dstOffset + region.size}});
-    vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), 1, &region);
+    copy_regions(src, dst, {&region, 1});
+  }
+  // One copy command, its barrier by the bytes its regions read and write.
+  void copy_regions(const Buffer& src, const Buffer& dst, std::span<const VkBufferCopy> regions) {
+    std::vector<Span> reads, writes;
+    long long n = 0;
+    for (const VkBufferCopy& region : regions) {
+      reads.push_back({src.handle(), region.srcOffset, region.srcOffset + region.size});
+      writes.push_back({dst.handle(), region.dstOffset, region.dstOffset + region.size});
+      n += static_cast<long long>(region.size);
+    }
+    order(reads, writes);
+    vkCmdCopyBuffer(commands_, src.handle(), dst.handle(), static_cast<uint32_t>(regions.size()), regions.data());
     ++work_.copies;
-    const auto n = static_cast<long long>(region.size);
     count("copy", 0, {n, n, 0});
   }
 

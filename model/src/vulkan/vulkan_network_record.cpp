@@ -107,15 +107,12 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
     }
     return true;
   };
-  bool pyramid_recorded = false;  // with the frame's input, just before it
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (f.absorbed[i]) continue;
     const auto& op = ops[i].op;
     if (f.pyramid[i]) {
       const auto pools = *pyramid_at(ops, graph_.tensors, i);
-      if (pyramid_recorded) {
-        pyramid_recorded = false;
-      } else if (own_buffers(pools)) {
+      if (own_buffers(pools)) {
         record_op(r, pools);
       } else {
         for (const auto* pool : pools) record_op(r, *pool);
@@ -124,14 +121,14 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
                frame && r.frame_layout() && i + 1 < ops.size() && f.pyramid[i + 1]) {
       // An 8-bit frame converted and pooled in one dispatch (frame_pyramid).
       const auto pools = *pyramid_at(ops, graph_.tensors, i + 1);
-      pyramid_recorded = pools[0]->in.tensor == frame->out.tensor && own_buffers(pools);
-      if (pyramid_recorded) {
+      if (pools[0]->in.tensor == frame->out.tensor && own_buffers(pools)) {
         record_op(r, *frame, pools);
+        ++i;  // the pyramid's first pooling; the other two are absorbed
       } else {
         record_op(r, *frame);
       }
     } else if (f.update_first[i]) {
-      record_op(r, std::get<graph::LocalCorrelation>(op), *f.update_first[i]);
+      record_op(r, std::get<graph::LocalCorrelation>(op), f.update_first[i]);
     } else if (f.affine_after[i]) {
       record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);
     } else {

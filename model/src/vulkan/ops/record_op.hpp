@@ -31,8 +31,9 @@ void record_op(Recorder& r, const graph::Copy& op);
 void record_op(Recorder& r, const graph::CopyRows& op);
 void record_op(Recorder& r, const graph::Zero& op);
 void record_op(Recorder& r, const graph::LocalCorrelation& op);
-// The correlation with the previous refinement step's update applied first (one dispatch).
-void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::RefineUpdate& previous);
+// The correlation with the previous refinement step's update applied first, in one dispatch
+// (`previous` nullptr: the correlation alone).
+void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::RefineUpdate* previous);
 void record_op(Recorder& r, const graph::RefineUpdate& op);
 void record_op(Recorder& r, const graph::ConvexUpsample& op);
 void record_op(Recorder& r, const graph::Output& op);
