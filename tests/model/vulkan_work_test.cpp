@@ -36,6 +36,11 @@ constexpr Budget kWinograd{131, 137, 102.1e6};
 // The same in three dispatches each (NEUFLOW_VULKAN_CONV=winograd-split, as the tensor-core
 // products run), the tiles and products through memory in fp32.
 constexpr Budget kWinogradSplit{287, 290, 330.5e6};
+// The fused form on tensor cores (their twin here) at 160×128 in fp16: 115.84 MB, where the
+// scalar fused form reads and writes 51.05 MB and the split one on tensor cores 216.81 MB. The
+// difference to the scalar form is the filters, read as transformed at upload (36 fp16 points
+// for 9 taps, padded to 16 channels): the 1/8 refinement reads its own at every step.
+constexpr Budget kWinogradFragments{131, 137, 115.9e6};
 constexpr double kWinogradRatioBudget = 0.55;  // measured 0.353
 
 class VulkanWork : public ::testing::Test {
@@ -177,6 +182,39 @@ TEST_F(VulkanWork, WinogradComputesFewerMultiplyAdds) {
   EXPECT_EQ(split.multiply_adds(), fused.multiply_adds());
   expect_within(fused, kWinograd);
   expect_within(split, kWinogradSplit);
+}
+
+// On tensor cores (here their emulated twin, which runs the same commands) the Winograd layers
+// are one dispatch each too (winograd_conv_fragments.comp): the tiles and products stay in the
+// workgroup, where the split form writes and reads them back in fp32.
+TEST_F(VulkanWork, OnTensorCoresAWinogradLayerIsOneDispatch) {
+  if (!list_gpu_devices().at(0).fp16) GTEST_SKIP() << "Vulkan device 0 has no fp16: the fragments multiply fp16";
+  constexpr int kW = 160, kH = 128;
+  const std::vector<cv::Mat> frames = test::camera_frames(frames_folder_, 2, cv::Size(kW, kH));
+  const auto streamed_frame = [&](const char* products, const char* conv) {
+    EXPECT_EQ(setenv("NEUFLOW_VULKAN_PRODUCTS", products, 1), 0);
+    EXPECT_EQ(setenv("NEUFLOW_VULKAN_CONV", conv, 1), 0);
+    FlowSession s(model_, {.backend = Backend::vulkan, .device = 0, .precision = Precision::fp16});
+    unsetenv("NEUFLOW_VULKAN_PRODUCTS");
+    unsetenv("NEUFLOW_VULKAN_CONV");
+    s.push(test::bgr_view(frames[0]));
+    s.push(test::bgr_view(frames[1]));
+    return s.device_work();
+  };
+  const DeviceWork scalar = streamed_frame("scalar", "winograd");
+  const DeviceWork fused = streamed_frame("twin", "winograd");
+  const DeviceWork split = streamed_frame("twin", "winograd-split");
+  print("fp16 Winograd at 160x128, scalar", scalar);
+  print("fp16 Winograd at 160x128, tensor cores (twin), fused", fused);
+  print("fp16 Winograd at 160x128, tensor cores (twin), split", split);
+  const int layers = test::dispatches_of(fused, "winograd_conv_coopmat_twin");
+  EXPECT_EQ(layers, test::dispatches_of(scalar, "winograd_conv"));
+  EXPECT_GT(layers, 0);
+  EXPECT_EQ(fused.dispatches, scalar.dispatches);
+  EXPECT_EQ(fused.barriers, scalar.barriers);
+  EXPECT_EQ(split.dispatches, fused.dispatches + 2 * layers);
+  EXPECT_EQ(fused.multiply_adds(), split.multiply_adds());
+  expect_within(fused, kWinogradFragments);
 }
 
 TEST_F(VulkanWork, APipelinedFrameTakesOneSubmissionAndOneWait) {

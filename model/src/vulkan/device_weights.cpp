@@ -15,31 +15,39 @@ namespace neuflow::model::vulkan {
 namespace {
 
 // G g Gᵀ for every (out, in) pair of a 3×3 convolution, as [36][out][in] (point 6·i + j of
-// the 6×6 result at i·6 + j), computed in double as the CPU backend's filters are.
+// the 6×6 result at i·6 + j) with out and in padded with zeros to multiples of 16 (a tensor-core
+// fragment's side), computed in double as the CPU backend's filters are.
 std::vector<float> winograd_f43_filters(const ConvWeights& conv) {
   const int out = conv.out_channels, in = conv.in_channels;
-  std::vector<float> u(static_cast<std::size_t>(36) * out * in);
+  const int out_pad = winograd_filter_side(out), in_pad = winograd_filter_side(in);
+  std::vector<float> u(static_cast<std::size_t>(36) * out_pad * in_pad, 0.f);
   for (int o = 0; o < out; ++o) {
     for (int i = 0; i < in; ++i) {
       double g[9], columns[18], points[36];
       for (int k = 0; k < 9; ++k) g[k] = conv.weight[(static_cast<std::size_t>(o) * in + i) * 9 + k];
       for (int x = 0; x < 3; ++x) winograd::F43::filter_1d(g + x, columns + x, 3, 3);  // G g: [6][3]
       for (int r = 0; r < 6; ++r) winograd::F43::filter_1d(columns + 3 * r, points + 6 * r, 1, 1);
-      for (int k = 0; k < 36; ++k) u[(static_cast<std::size_t>(k) * out + o) * in + i] = static_cast<float>(points[k]);
+      for (int k = 0; k < 36; ++k) {
+        u[(static_cast<std::size_t>(k) * out_pad + o) * in_pad + i] = static_cast<float>(points[k]);
+      }
     }
   }
   return u;
 }
 
 // Tensors laid out in one host vector; offsets are in floats.
+// `alignment` (in values) keeps every tensor's start 16-byte aligned: 4 values do in fp32 (vector
+// loads on some GPUs); the Winograd filters, whose fragments tensor cores load, take 16, which
+// does in fp16 too.
 struct Packed {
+  explicit Packed(std::size_t values_aligned) : alignment(values_aligned) {}
   int add(const std::vector<float>& values) {
     const int offset = static_cast<int>(data.size());
     data.insert(data.end(), values.begin(), values.end());
-    // 4-float alignment keeps every tensor's start 16-byte aligned (vector loads on some GPUs).
-    while (data.size() % 4 != 0) data.push_back(0.f);
+    while (data.size() % alignment != 0) data.push_back(0.f);
     return offset;
   }
+  std::size_t alignment;
   std::vector<float> data;
 };
 
@@ -56,7 +64,7 @@ struct Packer {
     winograd_filters.emplace(device.weight.offset, filters.add(winograd_f43_filters(host)));
   }
   bool winograd = false;
-  Packed weights, filters;
+  Packed weights{4}, filters{16};
   std::map<int, int> winograd_filters;
 };
 

@@ -22,14 +22,19 @@ using DeviceAttentionLayer = BasicAttentionLayerWeights<DeviceTensor>;
 using DeviceBlock = BasicConvBlockWeights<DeviceTensor>;
 using DeviceRefine = BasicRefineWeights<DeviceTensor>;
 
+// A side of the transformed Winograd filters: `channels` rounded up to a 16×16 fragment's.
+constexpr int winograd_filter_side(int channels) { return (channels + 15) / 16 * 16; }
+
 // The network's weights as the host holds them (weights.hpp), each tensor an offset here.
 struct DeviceWeights : BasicNetworkWeights<DeviceTensor> {
   std::shared_ptr<const FlowModel> model;  // keeps the key of the sharing registry unique
   std::shared_ptr<VulkanDevice> device;
   bool fp16 = false;  // stored as float16_t (offsets count elements either way)
   Buffer buffer;
-  // With Winograd: each 3×3 convolution's filters transformed for F(4×4, 3×3) (G g Gᵀ), as
-  // [36][out][in] in winograd_buffer, by the offset of its weight. Empty with direct convolutions.
+  // Where the network runs Winograd products apart from the tile transforms (the split form,
+  // and any form on tensor cores): each 3×3 convolution's filters transformed for F(4×4, 3×3)
+  // (G g Gᵀ), as [36][out][in] with out and in padded to winograd_filter_side(), at a multiple
+  // of 16 values in winograd_buffer, by the offset of its weight. Empty otherwise.
   std::map<int, int> winograd_filters;
   Buffer winograd_buffer;
 
@@ -40,7 +45,7 @@ struct DeviceWeights : BasicNetworkWeights<DeviceTensor> {
   }
 
   // The weights of `model` on `device` in that precision, uploaded on first use.
-  // winograd: with the transformed filters (conv_algorithm.hpp).
+  // winograd: with the transformed filters (conv_algorithm.hpp's winograd_filters_at_upload()).
   static std::shared_ptr<const DeviceWeights> get(const std::shared_ptr<const FlowModel>& model,
                                                   const std::shared_ptr<VulkanDevice>& device, bool fp16,
                                                   bool winograd);

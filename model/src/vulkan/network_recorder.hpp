@@ -235,6 +235,8 @@ class VulkanNetwork::Recorder {
   const DeviceWeights& device_weights() const { return *net_.weights_; }
   // How the stride-1 3×3 convolutions run (conv_algorithm.hpp).
   ConvAlgorithm conv_algorithm() const { return net_.conv_; }
+  // What the products run on (product_kernels.hpp).
+  ProductKernels product_kernels() const { return net_.products_; }
   // F(4×4, 3×3)'s transformed input tiles and their products (fp32), which the split Winograd
   // convolutions use in turn.
   const Buffer& winograd_points() const { return net_.winograd_points_; }

@@ -86,9 +86,9 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
       if (vulkan::records(shader, context->products)) device->pipeline(shader, true);
     }
   }
-  context->conv = vulkan::conv_algorithm_for(context->products);
-  context->weights =
-      vulkan::DeviceWeights::get(model, device, fp16, context->conv == vulkan::ConvAlgorithm::winograd_split);
+  context->conv = vulkan::conv_algorithm_for();
+  context->weights = vulkan::DeviceWeights::get(model, device, fp16,
+                                                vulkan::winograd_filters_at_upload(context->conv, context->products));
   return context;
 }
 

@@ -26,11 +26,8 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   if (products_ != ProductKernels::scalar && !fp16_) {
     throw std::logic_error("VulkanNetwork: the tensor-core products take fp16 tensors");
   }
-  if (products_ != ProductKernels::scalar && conv == ConvAlgorithm::winograd_fused) {
-    throw std::logic_error("VulkanNetwork: the fused Winograd convolution computes its products in scalar arithmetic");
-  }
-  if (conv == ConvAlgorithm::winograd_split && weights_->winograd_filters.empty()) {
-    throw std::logic_error("VulkanNetwork: the split Winograd convolution needs the filters transformed at upload");
+  if (winograd_filters_at_upload(conv, products_) && weights_->winograd_filters.empty()) {
+    throw std::logic_error("VulkanNetwork: these Winograd convolutions need the filters transformed at upload");
   }
   block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
   graph_ = graph::build_network_graph<DeviceTensor>(*weights_, height, width, kPlanIterations, block_rows_);

@@ -30,6 +30,38 @@ void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, c
                                     tiles(tile_count, "a convolution", 32), tiles(out.c, "a convolution", 16));
 }
 
+// F(4×4, 3×3) in one dispatch with the products on fragments (winograd_conv_fragments.comp, on
+// tensor cores or their twin): the tiles transformed as they are loaded, the filters as
+// transformed at upload (fp16, padded to 16), the products transformed back with bias, addend
+// and activation as they are stored.
+void record_winograd_fragments(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
+                               const View& addend) {
+  const DeviceConv& w = *op.weights;
+  const int tiles_x = winograd_tiles(out.w), tile_count = tiles_x * winograd_tiles(out.h);
+  const int side_in = winograd_filter_side(in.c), side_out = winograd_filter_side(out.c);
+  const WinogradConvFragmentsParams p{in.c,
+                                      in.h,
+                                      in.w,
+                                      in.offset(),
+                                      out.c,
+                                      out.offset(),
+                                      tiles_x,
+                                      tile_count,
+                                      r.device_weights().winograd_filters_of(w),
+                                      side_in,
+                                      side_out,
+                                      w.bias.offset,
+                                      op.addend ? addend.offset() : -1,
+                                      activation_code(op.act)};
+  const long long filters = 36LL * side_out * side_in;  // fp16, as the fragments load them
+  const long long read =
+      r.bytes(in.count() + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0)) + filters * 2;
+  r.record_dispatch(product_shader(Shader::winograd_conv, r.product_kernels()),
+                    {&r.weights(), in.buffer, out.buffer, addend.buffer, &r.device_weights().winograd_buffer}, &p,
+                    sizeof p, {read, r.bytes(out.count()), 36LL * out.c * in.c * tile_count},
+                    {tiles(tile_count, "a convolution", 16), tiles(out.c, "a convolution", 16), 1});
+}
+
 // F(4×4, 3×3) in three dispatches: the input tiles transformed, 36 products of the filters
 // transformed at upload by those tiles, the products transformed back with bias, addend and
 // activation. A quarter of the direct convolution's multiply-adds, at the cost of moving the
@@ -47,7 +79,8 @@ void record_winograd(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const V
   const long long filters = 36LL * out.c * in.c;
   r.product<Shader::winograd_gemm>(
       {&r.device_weights().winograd_buffer, &r.winograd_points(), &r.winograd_products(), nullptr},
-      WinogradGemmParams{out.c, tile_count, in.c, r.device_weights().winograd_filters_of(w)},
+      WinogradGemmParams{out.c, tile_count, in.c, r.device_weights().winograd_filters_of(w), winograd_filter_side(in.c),
+                         winograd_filter_side(out.c)},
       {r.bytes(filters) + fp32(points), fp32(products), filters * tile_count}, tiles(tile_count, "a convolution"),
       tiles(out.c, "a convolution"), 36);
   const WinogradOutputParams p{out.c,
@@ -79,6 +112,8 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
   if (takes_winograd(r.conv_algorithm(), op, out.h, out.w)) {
     if (r.conv_algorithm() == ConvAlgorithm::winograd_split) {
       record_winograd(r, op, in, out, addend);
+    } else if (r.product_kernels() != ProductKernels::scalar) {
+      record_winograd_fragments(r, op, in, out, addend);
     } else {
       record_winograd_fused(r, op, in, out, addend, read);
     }

@@ -6,7 +6,7 @@
 //    C is the planar output. Bias and activation fused; `addend` (same shape as C) is added
 //    before the activation.
 //  - WINOGRAD_GEMM: the 36 products of F(4×4, 3×3), one per workgroup z: the transformed
-//    filters [36][Cout][Cin] (binding 0) by the transformed input tiles [36][Cin][tiles] into
+//    filters [36][Cout][Cin] (binding 0, both sides padded to 16) by the transformed input tiles [36][Cin][tiles] into
 //    [36][Cout][tiles]; the tiles and products are fp32 in either precision.
 //  - otherwise a general strided product (attention, matching): every operand has a row and a
 //    column stride, so transposes are free.
@@ -53,7 +53,7 @@ float gemm_a(int m, int k) {
 #if defined(IMPLICIT_CONV)
   return float(a_data[p.w_off + m * gemm_k() + k]);
 #elif defined(WINOGRAD_GEMM)
-  return float(a_data[p.w_off + (int(gl_WorkGroupID.z) * gemm_m() + m) * gemm_k() + k]);
+  return float(a_data[p.w_off + (int(gl_WorkGroupID.z) * p.filters_out + m) * p.filters_in + k]);
 #else
   return float(a_data[p.a_off + m * p.a_rs + k * p.a_cs]);
 #endif

@@ -1,0 +1,21 @@
+// winograd_conv_coopmat and its twin (winograd_conv_fragments.comp): a stride-1 3×3 convolution
+// with padding 1 by F(4×4, 3×3) in one dispatch, the 36 point products on 16×16 fragments, with
+// bias, addend and activation. The filters were transformed at upload (DeviceWeights), as
+// [36][filters_out][filters_in] fp16 with both sides padded with zeros to multiples of 16, so a
+// fragment loads them straight from binding 4.
+#ifndef NEUFLOW_SHADER_WINOGRAD_CONV_FRAGMENTS_PARAMS_H
+#define NEUFLOW_SHADER_WINOGRAD_CONV_FRAGMENTS_PARAMS_H
+#include "activation.h"
+
+NEUFLOW_PUSH_CONSTANTS(WinogradConvFragmentsParams)
+  int in_c, h, w, in_off;           // planar input (binding 1), channel 0 at in_off; the output is as large
+  int out_c, out_off;               // planar output (binding 2), channel 0 at out_off
+  int tiles_x, tiles;               // 4×4 output tiles per row, in all
+  int filters_off;                  // in binding 4, a multiple of 16
+  int filters_in, filters_out;      // in_c and out_c rounded up to multiples of 16
+  int bias_off;                     // in binding 0 (the weights); < 0: none
+  int add_off;                      // the addend (binding 3), shaped as the output; < 0: none
+  int act;                          // one of activation.h's codes
+NEUFLOW_PUSH_CONSTANTS_END
+
+#endif
