@@ -6,7 +6,10 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
+#include <chrono>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -89,6 +92,22 @@ class Session {
     const py::gil_scoped_release unlocked;
     const std::lock_guard lock(mutex_);
     session_.reset();
+  }
+
+  // Seconds a compute() of these frames takes in C++ alone, the least of `runs`: what the
+  // binding's overhead is measured against (bench/python_binding_overhead.py).
+  double time_compute(const py::handle& frame0, const py::handle& frame1, int runs) {
+    const Frame a = frame_from(frame0, frame_order_, "frame0");
+    const Frame b = frame_from(frame1, frame_order_, "frame1");
+    const py::gil_scoped_release unlocked;
+    const std::lock_guard lock(mutex_);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < runs; ++i) {
+      const auto start = std::chrono::steady_clock::now();
+      const flow::FlowField flow = session_.compute(a.view, b.view);
+      best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    return best;
   }
 
   const std::string& device() const { return session_.backend_description(); }
@@ -218,6 +237,8 @@ void bind_model(py::module_& m) {
            "Streaming: the flow from the previous frame to this one, or None for the first frame (and the first "
            "after reset() or a change of frame size). Each frame's features are computed once.")
       .def("reset", &Session::reset, "Forgets the stream: the next push() returns None.")
+      .def("_time_compute", &Session::time_compute, py::arg("frame0"), py::arg("frame1"), py::arg("runs") = 3,
+           "Seconds compute() takes in C++ alone, the least of `runs` (for bench/python_binding_overhead.py).")
       .def_property_readonly("device", &Session::device, "Where the network runs, e.g. 'cpu'.")
       .def_property_readonly(
           "options",
