@@ -3,7 +3,9 @@
 #                systemd units, the sysusers.d file, the example configs in /etc/neuflow/examples
 #                (conffiles) and the docs;
 #   neuflow-dev  the `development` component: the core's headers and static libraries and the
-#                CMake package (find_package(neuflow), cmake/NeuflowExport.cmake).
+#                CMake package (find_package(neuflow), cmake/NeuflowExport.cmake);
+#   python3-neuflow  the `python` component (NEUFLOW_BUILD_PYTHON): `import neuflow` in
+#                /usr/lib/python3/dist-packages, the core linked into it.
 # The package's prefix is /usr whatever the build folder's CMAKE_INSTALL_PREFIX: CPack installs
 # with DESTDIR and CMAKE_INSTALL_PREFIX=/usr, so the install-time paths (the units' ExecStart,
 # /etc for the configs) are the package's.
@@ -21,6 +23,9 @@ set(CPACK_PACKAGE_DIRECTORY ${CMAKE_BINARY_DIR}/packages)
 
 set(CPACK_DEB_COMPONENT_INSTALL ON)
 set(CPACK_COMPONENTS_ALL runtime development)
+if(NEUFLOW_BUILD_PYTHON AND TARGET neuflow_python)
+  list(APPEND CPACK_COMPONENTS_ALL python)
+endif()
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)   # neuflow_0.1.0-1_amd64.deb
 set(CPACK_DEBIAN_PACKAGE_RELEASE 1)
 set(neuflow_deb_version "${PROJECT_VERSION}-${CPACK_DEBIAN_PACKAGE_RELEASE}")
@@ -89,5 +94,30 @@ set(CPACK_DEBIAN_DEVELOPMENT_PACKAGE_DEPENDS
 set(CPACK_COMPONENT_DEVELOPMENT_DESCRIPTION "NeuFlow-V2 optical flow: headers, static libraries and CMake package
 find_package(neuflow) gives neuflow::model (the network, its sessions, the CPU and Vulkan
 backends) and neuflow::flow (flow fields, .flo / KITTI PNG / .npy, colour wheel, metrics).")
+
+# The module is built for one interpreter version (its ABI tag, e.g. cpython-311), which the
+# dependency pins; its libraries come from dpkg-shlibdeps as the runtime package's do.
+if(NEUFLOW_BUILD_PYTHON AND TARGET neuflow_python)
+  string(REPLACE "." ";" neuflow_python_parts "${NEUFLOW_PYTHON_VERSION}")
+  list(GET neuflow_python_parts 0 neuflow_python_major)
+  list(GET neuflow_python_parts 1 neuflow_python_minor)
+  math(EXPR neuflow_python_next "${neuflow_python_minor} + 1")
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-neuflow)
+  set(CPACK_DEBIAN_PYTHON_FILE_NAME DEB-DEFAULT)
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_SHLIBDEPS ${CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS})
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS
+      "python3 (>= ${NEUFLOW_PYTHON_VERSION}), python3 (<< ${neuflow_python_major}.${neuflow_python_next}), python3-numpy")
+  if(NEUFLOW_DEB_SHLIB_DEPENDS)
+    string(APPEND CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS ", ${NEUFLOW_DEB_SHLIB_DEPENDS}")
+  endif()
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_CONTROL_EXTRA ${PROJECT_SOURCE_DIR}/packaging/debian/python3-neuflow/prerm)
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+  set(CPACK_DEBIAN_PYTHON_PACKAGE_RECOMMENDS "python3-opencv, libvulkan1, mesa-vulkan-drivers | vulkan-icd")
+  set(CPACK_COMPONENT_PYTHON_DESCRIPTION "NeuFlow-V2 optical flow for Python: import neuflow
+The NeuFlow-V2 core (CPU and Vulkan backends) on NumPy arrays: neuflow.Model and its sessions
+compute flow for pairs and streams of frames; read_flow and write_flow take .flo, KITTI PNG and
+.npy files; flow_to_color draws the colour wheel; epe and metrics score flow against ground truth.")
+endif()
 
 include(CPack)

@@ -3,12 +3,14 @@
 # cmake/NeuflowPackaging.cmake) and tries them as a user would:
 #   - neuflow-dev: a program outside the project (tests/package/consumer) configured with
 #     find_package(neuflow) against the package's contents, built, and run on the fixture model;
-#   - neuflow: installed with `apt-get install ./neuflow_*.deb` into a clean Debian 12 root made
-#     for the test (mmdebstrap, from Debian's archive), which pulls in its dependencies; there
+#   - neuflow (and python3-neuflow where the build has the Python module): installed with
+#     `apt-get install ./neuflow_*.deb ./python3-neuflow_*.deb` into a clean Debian 12 root made
+#     for the test (mmdebstrap, from Debian's archive), which pulls in their dependencies; there
 #     tests/package/installed_checks.sh runs (gst-inspect-1.0 without GST_PLUGIN_PATH, neuflowd
 #     --check-config on the examples in /etc/neuflow, systemd-analyze verify on the units, the
-#     user and group, a flow and a gst-launch pipeline, the units enabled); then the package is
-#     purged and nothing of it may remain, no link to its units either.
+#     user and group, a flow and a gst-launch pipeline, the units enabled, `import neuflow` and a
+#     flow from Python); then the packages are purged and nothing of them may remain, no link to
+#     the units either.
 #
 # Usage: bash scripts/check-deb.sh [--packages-only] [BUILD_DIR]   (BUILD_DIR: build/release)
 #   --packages-only  build the packages only (build/release/packages), as the README's command
@@ -28,7 +30,9 @@ rm -rf "$build/packages"
 (cd "$build" && cpack -G DEB > cpack.log) || { cat "$build/cpack.log"; exit 1; }
 deb=$(ls "$build"/packages/neuflow_*.deb)
 dev_deb=$(ls "$build"/packages/neuflow-dev_*.deb)
-say "built $(basename "$deb") ($(du -k "$deb" | cut -f1) KiB) and $(basename "$dev_deb") ($(du -k "$dev_deb" | cut -f1) KiB) in $build/packages"
+python_deb=$(ls "$build"/packages/python3-neuflow_*.deb 2>/dev/null || true)  # none with NEUFLOW_BUILD_PYTHON=OFF
+say "built $(basename "$deb") ($(du -k "$deb" | cut -f1) KiB), $(basename "$dev_deb") ($(du -k "$dev_deb" | cut -f1) KiB)" \
+    "${python_deb:+and $(basename "$python_deb") ($(du -k "$python_deb" | cut -f1) KiB) }in $build/packages"
 [ "$packages_only" -eq 1 ] && exit 0
 
 work=$(pwd)/build/deb
@@ -58,7 +62,8 @@ say "neuflow-dev: a find_package(neuflow) consumer builds against the package${c
 # --- neuflow: apt-get install into a clean Debian 12 root -----------------------------------
 data="$work/data"
 mkdir -p "$data"
-cp "$deb" tests/package/installed_checks.sh "$data/"
+cp "$deb" ${python_deb:+"$python_deb"} tests/package/installed_checks.sh "$data/"
+installs="/tmp/neuflow-check/$(basename "$deb")${python_deb:+ /tmp/neuflow-check/$(basename "$python_deb")}"
 if [ -n "$checkpoint" ]; then
   cp "$checkpoint" "$data/checkpoint.pth"
   frames=("$shared"/fixtures/frames/*.jpg)
@@ -77,11 +82,11 @@ mmdebstrap --quiet --variant=apt --mode="$([ "$(id -u)" -eq 0 ] && echo root || 
   --dpkgopt='path-exclude=/usr/share/man/*' --dpkgopt='path-exclude=/usr/share/locale/*' \
   --customize-hook='mkdir -p "$1/tmp/neuflow-check"' \
   --customize-hook="copy-in $(cd "$data" && ls | sed "s|^|$data/|" | tr '\n' ' ') /tmp/neuflow-check" \
-  --customize-hook="chroot \"\$1\" apt-get install -y --no-install-recommends /tmp/neuflow-check/$(basename "$deb")" \
+  --customize-hook="chroot \"\$1\" apt-get install -y --no-install-recommends $installs" \
   --customize-hook='chroot "$1" bash /tmp/neuflow-check/installed_checks.sh /tmp/neuflow-check' \
-  --customize-hook='chroot "$1" sh -c "dpkg -L neuflow > /tmp/neuflow-check/files"' \
-  --customize-hook='chroot "$1" apt-get purge -y neuflow' \
-  --customize-hook='chroot "$1" sh -c "left=0; while read -r f; do if [ -e \"\$f\" ] && [ ! -d \"\$f\" ]; then echo \"left behind: \$f\"; left=1; fi; done < /tmp/neuflow-check/files; [ ! -e /etc/neuflow ] || { echo \"left behind: /etc/neuflow\"; left=1; }; links=\$(find /etc/systemd/system -name \"neuflowd*\"); [ -z \"\$links\" ] || { echo \"left behind: \$links\"; left=1; }; exit \$left"' \
+  --customize-hook="chroot \"\$1\" sh -c \"dpkg -L neuflow${python_deb:+ python3-neuflow} > /tmp/neuflow-check/files\"" \
+  --customize-hook="chroot \"\$1\" apt-get purge -y neuflow${python_deb:+ python3-neuflow}" \
+  --customize-hook='chroot "$1" sh -c "left=0; while read -r f; do if [ -e \"\$f\" ] && [ ! -d \"\$f\" ]; then echo \"left behind: \$f\"; left=1; fi; done < /tmp/neuflow-check/files; [ ! -e /etc/neuflow ] || { echo \"left behind: /etc/neuflow\"; left=1; }; [ ! -e /usr/lib/python3/dist-packages/neuflow ] || { echo \"left behind: /usr/lib/python3/dist-packages/neuflow\"; left=1; }; links=\$(find /etc/systemd/system -name \"neuflowd*\"); [ -z \"\$links\" ] || { echo \"left behind: \$links\"; left=1; }; exit \$left"' \
   bookworm /dev/null
-say "neuflow: installed with its dependencies into a clean Debian 12 root, checked, purged" \
+say "neuflow${python_deb:+ and python3-neuflow}: installed with their dependencies into a clean Debian 12 root, checked, purged" \
     "without leftovers ($(( $(date +%s) - start )) s)"

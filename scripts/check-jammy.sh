@@ -54,7 +54,7 @@ jammy_packages=(
   gstreamer1.0-rtsp libgstrtspserver-1.0-dev
   libsystemd-dev systemd libsoup-3.0-dev libcurl4-openssl-dev libssl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-numpy
+  python3 python3-numpy python3-dev pybind11-dev python3-pytest python3-opencv
 )
 # toml++ 3.3.0's headers, as a JetPack user gets them (a source checkout's include/); here from
 # the host's Debian package, which installs the same header tree.

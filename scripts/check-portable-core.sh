@@ -14,7 +14,7 @@ if ! command -v g++-11 >/dev/null; then
 fi
 cmake -S . -B "$build" -G Ninja -DCMAKE_C_COMPILER=gcc-11 -DCMAKE_CXX_COMPILER=g++-11 \
   -DCMAKE_BUILD_TYPE=Release -DNEUFLOW_WERROR=ON -DNEUFLOW_X86_AVX2=OFF \
-  -DNEUFLOW_BUILD_BENCHMARKS=OFF -DNEUFLOW_BUILD_PLUGIN=OFF >/dev/null
+  -DNEUFLOW_BUILD_BENCHMARKS=OFF -DNEUFLOW_BUILD_PLUGIN=OFF -DNEUFLOW_BUILD_PYTHON=OFF >/dev/null
 cmake --build "$build" --target neuflow_flow neuflow_session_settings neuflow_checkpoint neuflow_model \
   winograd_conv_tests network_kernel_tests
 "$build/tests/model/winograd_conv_tests"

@@ -34,6 +34,8 @@ packages=(
   clang-format-14 clang-tidy-14     # CI's first stage: .clang-format, .clang-tidy
   g++-11                            # JetPack 6's compiler: CI compiles the core with it
   python3 python3-numpy             # tests check that numpy reads our .npy files
+  python3-dev pybind11-dev          # the Python module (python/)
+  python3-pytest python3-opencv     # its tests and examples
 )
 if [ $# -gt 0 ]; then packages=("$@"); fi
 

@@ -67,3 +67,18 @@ if [ -f "$data/checkpoint.pth" ]; then
   [ "$flows" -eq 3 ] || fail "the pipeline wrote $flows flow files, not 3"
   ok "neuflow flow and a gst-launch pipeline compute flow with the installed core"
 fi
+
+# python3-neuflow, where it was installed beside: the interpreter finds it without PYTHONPATH.
+if dpkg-query -W -f='${Status}' python3-neuflow 2>/dev/null | grep -q "install ok installed"; then
+  module=$(cd / && python3 -c "import neuflow; print(neuflow.__file__)") || fail "python3 cannot import neuflow"
+  case "$module" in /usr/lib/python3/dist-packages/neuflow/*) ;; *) fail "neuflow imported from $module" ;; esac
+  if [ -f "$data/checkpoint.pth" ]; then
+    flow_shape=$(cd / && python3 -c "
+import neuflow, numpy as np
+session = neuflow.Model('$data/checkpoint.pth', backend='cpu').session(iters_s8=1)
+frame = np.random.default_rng(0).integers(0, 256, (48, 64, 3), dtype=np.uint8)
+print(session.compute(frame, np.roll(frame, 2, axis=1)).shape)") || fail "python3-neuflow computes no flow"
+    [ "$flow_shape" = "(48, 64, 2)" ] || fail "python3-neuflow's flow has the shape $flow_shape"
+  fi
+  ok "python3-neuflow: import neuflow from $module${flow_shape:+, a flow of $flow_shape}"
+fi
