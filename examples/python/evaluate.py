@@ -54,6 +54,8 @@ def main():
         height, width = gt.shape[:2]
         flow = session.compute(a, b)[top:top + height, left:left + width]
         m = neuflow.metrics(flow, gt)
+        if m["valid_pixels"] == 0:  # no ground truth to score (its EPE is NaN): counts nothing
+            continue
         error_sum += m["epe"] * m["valid_pixels"]
         pixels += m["valid_pixels"]
         rows.append({"sequence": sequence, "epe": m["epe"], "valid_pixels": m["valid_pixels"]})

@@ -107,9 +107,12 @@ const DeviceWork& FlowSession::device_work() const { return state_->work; }
 
 namespace {
 
-// OpenMP's thread count is per calling thread; oneDNN and our loops both read it.
+// OpenMP's thread count is per calling thread; oneDNN and our loops both read it. An earlier
+// session on this thread may have changed it: 0 sets OpenMP's default back (as the process
+// started with it) rather than keeping that.
 void apply_threads(int threads) {
-  if (threads > 0) omp_set_num_threads(threads);
+  static const int openmp_default = omp_get_max_threads();
+  omp_set_num_threads(threads > 0 ? threads : openmp_default);
 }
 
 // The flow of a frame the backend has finished, at the frame's own size.

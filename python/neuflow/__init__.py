@@ -10,7 +10,16 @@
 help(neuflow.Model) and help(neuflow.Session) list the options.
 """
 
-from ._neuflow import (  # noqa: F401
+import numpy as _numpy
+
+from . import _neuflow
+
+if int(_numpy.__version__.split(".")[0]) >= 2 and _neuflow._pybind11_version < (2, 12):
+    raise ImportError(f"neuflow was built with pybind11 {'.'.join(map(str, _neuflow._pybind11_version))}, which "
+                      f"reads NumPy 1's arrays only, and this is NumPy {_numpy.__version__}: rebuild it with "
+                      "pybind11 2.12 or later, or use NumPy 1")
+
+from ._neuflow import (  # noqa: E402,F401
     BackendError,
     Model,
     ModelError,

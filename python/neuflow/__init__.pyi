@@ -10,6 +10,8 @@ __version__: str
 Path = Union[str, os.PathLike[str]]
 Frame = npt.NDArray[np.uint8]  # (H, W, 3) in the session's frame_order, or (H, W) grey
 Flow = npt.NDArray[np.float32]  # (H, W, 2): u (right), v (down) in pixels; NaN where invalid
+FlowIn = npt.NDArray[np.floating]  # (H, W, 2), any float dtype (taken as float32)
+Mask = npt.NDArray[Union[np.bool_, np.integer]]  # (H, W): nonzero where valid
 
 class ModelError(Exception):
     """The file is not a NeuFlow-V2 checkpoint the core can load."""
@@ -43,7 +45,7 @@ class Metrics(TypedDict):
     valid_pixels: int
 
 class Session:
-    """Computes flow with a Model; Model.session() makes one."""
+    """Computes flow with a Model; Model.session() makes one (there is no constructor)."""
 
     def compute(self, frame0: Frame, frame1: Frame) -> Flow:
         """The flow from frame0 to frame1 (same size). Does not touch the stream."""
@@ -55,6 +57,7 @@ class Session:
     def device(self) -> str: ...
     @property
     def options(self) -> SessionOptions: ...
+    def _time_compute(self, frame0: Frame, frame1: Frame, runs: int = 3) -> float: ...
 
 class Model:
     """A NeuFlow-V2 checkpoint loaded for inference, shared read-only by its sessions."""
@@ -82,18 +85,18 @@ class Model:
 def read_flow(path: Path) -> Flow:
     """Reads a .flo, KITTI .png or .npy flow file; invalid pixels are NaN."""
 
-def write_flow(path: Path, flow: npt.ArrayLike, valid: Optional[npt.ArrayLike] = None) -> None:
+def write_flow(path: Path, flow: FlowIn, valid: Optional[Mask] = None) -> None:
     """Writes a .flo, KITTI .png or .npy flow file, atomically."""
 
 def flow_to_color(
-    flow: npt.ArrayLike, max_flow: Optional[float] = None, valid: Optional[npt.ArrayLike] = None
+    flow: FlowIn, max_flow: Optional[float] = None, valid: Optional[Mask] = None
 ) -> npt.NDArray[np.uint8]:
     """The colour-wheel picture of flow, (H, W, 3) RGB."""
 
-def epe(flow: npt.ArrayLike, gt: npt.ArrayLike, valid: Optional[npt.ArrayLike] = None) -> float:
+def epe(flow: FlowIn, gt: FlowIn, valid: Optional[Mask] = None) -> float:
     """Mean end-point error in px over the pixels where gt is finite (and valid)."""
 
-def metrics(flow: npt.ArrayLike, gt: npt.ArrayLike, valid: Optional[npt.ArrayLike] = None) -> Metrics:
+def metrics(flow: FlowIn, gt: FlowIn, valid: Optional[Mask] = None) -> Metrics:
     """epe, fl_all, within_1px/3px/5px and valid_pixels, as `neuflow eval` reports them."""
 
 def _takes_without_copy(frame: Frame) -> bool: ...

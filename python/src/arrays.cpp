@@ -1,5 +1,6 @@
 #include "arrays.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -7,6 +8,7 @@
 #include <string>
 
 #include "neuflow/flow/limits.hpp"
+#include "neuflow/model/session_settings.hpp"
 
 namespace neuflow::python {
 
@@ -36,12 +38,17 @@ Frame frame_from(const py::handle& object, model::ChannelOrder order, const char
   constexpr const char* expected = "a NumPy uint8 array of shape (H, W, 3) or (H, W)";
   const py::array a = as_array(object, what, expected);
   const bool colour = a.ndim() == 3 && a.shape(2) == 3;
-  if (!a.dtype().is(py::dtype::of<std::uint8_t>()) || !(colour || a.ndim() == 2)) {
+  // By value, not identity: an unpickled array (multiprocessing) has a dtype object of its own.
+  const bool bytes = a.dtype().kind() == 'u' && a.dtype().itemsize() == 1;
+  if (!bytes || !(colour || a.ndim() == 2)) {
     throw py::value_error(std::string(what) + ": expected " + expected + ", got " + described(a));
   }
   const auto height = a.shape(0), width = a.shape(1);
-  if (height > std::numeric_limits<int>::max() || width > std::numeric_limits<int>::max()) {
-    throw py::value_error(std::string(what) + ": " + shape_of(a) + " is too large a frame");
+  // Before anything is copied: a broadcast view can claim any size without the memory.
+  constexpr auto largest = model::SessionLimits::max_side;
+  if (height > largest || width > largest) {
+    throw py::value_error(std::string(what) + ": a frame of " + shape_of(a) + " is larger than the " +
+                          std::to_string(largest) + " pixels a side the network takes");
   }
   Frame f;
   f.view.width = static_cast<int>(width);
@@ -76,9 +83,11 @@ flow::FlowField field_from(const py::handle& object, const py::handle& valid, co
     throw py::value_error(std::string(what) + ": expected a float array of shape (H, W, 2), got " + described(given));
   }
   if (!flow::flow_size_acceptable(given.shape(1), given.shape(0))) {
-    throw py::value_error(std::string(what) + ": a flow field of " + shape_of(given) + " is not a size flow files take");
+    throw py::value_error(std::string(what) + ": a flow field of " + shape_of(given) +
+                          " is not a size flow files take");
   }
   const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(given);
+  if (!a) throw py::error_already_set();  // the conversion failed (out of memory)
   flow::FlowField field(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
   std::copy(a.data(), a.data() + field.uv.size(), field.uv.begin());
   if (!valid.is_none()) {
@@ -88,8 +97,12 @@ flow::FlowField field_from(const py::handle& object, const py::handle& valid, co
       throw py::value_error("valid: expected a bool or integer array of shape (" + std::to_string(a.shape(0)) + ", " +
                             std::to_string(a.shape(1)) + "), the flow's, got " + described(m));
     }
-    const auto mask = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(m);
-    field.valid.assign(mask.data(), mask.data() + field.pixel_count());
+    // As bool, so any nonzero integer is valid (a cast to uint8 would take 256 as 0).
+    const auto mask = py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(m);
+    if (!mask) throw py::error_already_set();
+    field.valid.resize(field.pixel_count());
+    std::transform(mask.data(), mask.data() + field.pixel_count(), field.valid.begin(),
+                   [](bool v) { return static_cast<std::uint8_t>(v ? 1 : 0); });
   }
   return field;
 }
@@ -105,9 +118,10 @@ py::array_t<float> array_from(flow::FlowField&& field) {
   py::capsule free_when_done(owner.get(), [](void* p) { delete static_cast<std::vector<float>*>(p); });
   owner.release();
   const py::ssize_t h = field.height, w = field.width;
-  return py::array_t<float>({h, w, py::ssize_t{2}}, {w * 2 * py::ssize_t{sizeof(float)}, 2 * py::ssize_t{sizeof(float)},
-                                                     py::ssize_t{sizeof(float)}},
-                            data, free_when_done);
+  return py::array_t<float>(
+      {h, w, py::ssize_t{2}},
+      {w * 2 * py::ssize_t{sizeof(float)}, 2 * py::ssize_t{sizeof(float)}, py::ssize_t{sizeof(float)}}, data,
+      free_when_done);
 }
 
 }  // namespace neuflow::python

@@ -18,6 +18,13 @@ namespace py = pybind11;
 // 8-bit triples (rows may be strided, as a crop's are), else a copy kept in `copy`. `keep`
 // holds the array while the view reads it.
 struct Frame {
+  Frame() = default;
+  Frame(Frame&&) = default;  // `copy`'s buffer moves with it, so `view` stays valid
+  Frame& operator=(Frame&&) = default;
+  Frame(const Frame&) = delete;  // a copy's view would read the original's buffer
+  Frame& operator=(const Frame&) = delete;
+  ~Frame() = default;
+
   model::ImageView view;
   bool borrowed = false;
   py::object keep;

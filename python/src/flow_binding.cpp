@@ -67,7 +67,10 @@ void bind_flow(py::module_& m) {
         "The standard colour-wheel picture of flow as an RGB uint8 array of shape (H, W, 3): hue is the direction, "
         "saturation the magnitude up to max_flow px (None: the field's largest). Invalid pixels are black.");
   m.def(
-      "epe", [](const py::handle& flow, const py::handle& gt, const py::handle& valid) { return measure(flow, gt, valid).epe; },
+      "epe",
+      [](const py::handle& flow, const py::handle& gt, const py::handle& valid) {
+        return measure(flow, gt, valid).epe;
+      },
       py::arg("flow"), py::arg("gt"), py::arg("valid") = py::none(),
       "Mean end-point error |flow - gt| in px over the pixels where gt is finite (and `valid`, when given, is "
       "true). NaN when there is none; infinite when flow is not finite at such a pixel.");

@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <utility>
 
 #include "arrays.hpp"
@@ -29,7 +30,6 @@ namespace neuflow::python {
 
 namespace {
 
-
 // The option's name as a Python keyword: "iters-s16" → "iters_s16".
 std::string keyword(const model::OptionDoc& doc) {
   std::string name(doc.name);
@@ -38,7 +38,9 @@ std::string keyword(const model::OptionDoc& doc) {
 }
 
 // "keyword: help" for the docstrings.
-std::string documented(const model::OptionDoc& doc) { return "    " + keyword(doc) + ": " + std::string(doc.help) + ".\n"; }
+std::string documented(const model::OptionDoc& doc) {
+  return "    " + keyword(doc) + ": " + std::string(doc.help) + ".\n";
+}
 
 void check(const std::optional<std::string>& problem, const model::OptionDoc& doc) {
   if (problem) throw py::value_error(keyword(doc) + ": " + *problem);
@@ -48,6 +50,12 @@ template <typename T>
 T parse(std::optional<T> parsed, const std::string& given, const model::OptionDoc& doc, const char* expected) {
   if (!parsed) throw py::value_error(keyword(doc) + ": expected " + expected + ", got \"" + given + "\"");
   return *parsed;
+}
+
+// What a session does other than asked (FlowSession::fallback_warning()) as a RuntimeWarning.
+// Needs the GIL.
+void warn(const std::string& warning) {
+  if (!warning.empty() && PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
 }
 
 // A checkpoint loaded once per file in the process, the options its sessions share, and one
@@ -62,7 +70,25 @@ struct LoadedModel {
 class Session {
  public:
   Session(std::shared_ptr<LoadedModel> loaded, const model::SessionOptions& options, model::ChannelOrder frame_order)
-      : loaded_(std::move(loaded)), session_(loaded_->model, options), frame_order_(frame_order) {}
+      : loaded_(std::move(loaded)),
+        session_(loaded_->model, options),
+        frame_order_(frame_order),
+        reported_(loaded_->probe->fallback_warning()),  // the model's warning said it already
+        fallback_(session_.fallback_warning()) {}
+
+  // Warns once of a fallback the model's warning did not announce (a GPU that failed for this
+  // session, at its opening or at a frame size). Needs the GIL.
+  void warn_of_fallback() {
+    std::string now;
+    {
+      const std::lock_guard lock(mutex_);
+      now = fallback_;
+    }
+    if (now != reported_) {
+      reported_ = now;
+      warn(now);
+    }
+  }
 
   py::object compute(const py::handle& frame0, const py::handle& frame1) {
     const Frame a = frame_from(frame0, frame_order_, "frame0");
@@ -71,8 +97,10 @@ class Session {
     {
       const py::gil_scoped_release unlocked;
       const std::lock_guard lock(mutex_);
+      const Noted noted(*this);
       flow = session_.compute(a.view, b.view);
     }
+    warn_of_fallback();
     return array_from(std::move(flow));
   }
 
@@ -82,8 +110,10 @@ class Session {
     {
       const py::gil_scoped_release unlocked;
       const std::lock_guard lock(mutex_);
+      const Noted noted(*this);
       flow = session_.push(f.view);
     }
+    warn_of_fallback();
     if (!flow) return py::none();
     return array_from(std::move(*flow));
   }
@@ -110,15 +140,32 @@ class Session {
     return best;
   }
 
-  const std::string& device() const { return session_.backend_description(); }
+  // Where the network runs; it can change during a call (a GPU left for the CPU), so it is read
+  // under the lock, without the GIL.
+  std::string device() {
+    const py::gil_scoped_release unlocked;
+    const std::lock_guard lock(mutex_);
+    return session_.backend_description();
+  }
   const model::SessionOptions& options() const { return session_.options(); }
   model::ChannelOrder frame_order() const { return frame_order_; }
 
  private:
+  // Copies the session's fallback warning when a call ends, under the call's lock.
+  struct Noted {
+    explicit Noted(Session& s) : session(s) {}
+    ~Noted() { session.fallback_ = session.session_.fallback_warning(); }
+    Noted(const Noted&) = delete;
+    Noted& operator=(const Noted&) = delete;
+    Session& session;
+  };
+
   std::shared_ptr<LoadedModel> loaded_;  // the model outlives its sessions
   model::FlowSession session_;
   model::ChannelOrder frame_order_;
-  std::mutex mutex_;  // one call at a time: the GIL is not held while the network runs
+  std::mutex mutex_;      // one call at a time: the GIL is not held while the network runs
+  std::string reported_;  // the fallback warning last given (with the GIL)
+  std::string fallback_;  // the session's, as the last call left it (under mutex_)
 };
 
 std::shared_ptr<LoadedModel> load(const std::filesystem::path& path, const std::string& backend, int device,
@@ -134,13 +181,17 @@ std::shared_ptr<LoadedModel> load(const std::filesystem::path& path, const std::
   o.device = device;
   o.threads = threads;
   o.max_memory_mb = max_memory;
-  {
+  try {
     const py::gil_scoped_release unlocked;
     loaded->model = model::FlowModel::load_shared(path);
     loaded->probe = std::make_unique<model::FlowSession>(loaded->model, o);
+  } catch (const model::CheckpointError& e) {
+    std::error_code ec;
+    if (e.kind() != model::CheckpointError::Kind::kIo || std::filesystem::exists(path, ec)) throw;
+    PyErr_SetString(PyExc_FileNotFoundError, e.what());
+    throw py::error_already_set();
   }
-  const std::string& warning = loaded->probe->fallback_warning();
-  if (!warning.empty() && PyErr_WarnEx(PyExc_RuntimeWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
+  warn(loaded->probe->fallback_warning());
   return loaded;
 }
 
@@ -174,11 +225,19 @@ std::unique_ptr<Session> open_session(const std::shared_ptr<LoadedModel>& m, int
     o.model_height = model_size->second;
   }
   o.network_order = parse(model::parse_channel_order(channel_order), channel_order, docs::channel_order, "rgb or bgr");
-  const model::ChannelOrder frames =
-      frame_order ? parse(model::parse_channel_order(*frame_order), *frame_order, docs::channel_order, "rgb or bgr")
-                  : o.network_order;
-  const py::gil_scoped_release unlocked;  // a GPU session compiles and uploads
-  return std::make_unique<Session>(m, o, frames);
+  model::ChannelOrder frames = o.network_order;
+  if (frame_order) {
+    const auto parsed = model::parse_channel_order(*frame_order);
+    if (!parsed) throw py::value_error("frame_order: expected rgb or bgr, got \"" + *frame_order + "\"");
+    frames = *parsed;
+  }
+  std::unique_ptr<Session> session;
+  {
+    const py::gil_scoped_release unlocked;  // a GPU session compiles and uploads
+    session = std::make_unique<Session>(m, o, frames);
+  }
+  session->warn_of_fallback();
+  return session;
 }
 
 }  // namespace
@@ -194,8 +253,8 @@ void bind_model(py::module_& m) {
        "same file in the process).\n\n"
        "Model(path, backend='auto', device=-1, precision='fp32', threads=0, max_memory=0)\n\n"
        "    path: the checkpoint (.pth, the published format).\n" +
-       documented(docs::backend) + documented(docs::device) + documented(docs::precision) +
-       documented(docs::threads) + documented(docs::max_memory) +
+       documented(docs::backend) + documented(docs::device) + documented(docs::precision) + documented(docs::threads) +
+       documented(docs::max_memory) +
        "\nRaises OSError for a file it cannot read, neuflow.ModelError for one that is not a NeuFlow-V2 "
        "checkpoint, ValueError for an unusable option, neuflow.BackendError when backend='vulkan' finds no "
        "usable device. With backend='auto', a GPU that fails is left for the CPU with a RuntimeWarning.")
@@ -247,17 +306,18 @@ void bind_model(py::module_& m) {
             py::dict d;
             d["iters_s16"] = o.iterations.s16;
             d["iters_s8"] = o.iterations.s8;
-            d["model_size"] = o.model_width == 0 ? py::object(py::none())
-                                                 : py::object(py::make_tuple(o.model_width, o.model_height));
+            d["model_size"] =
+                o.model_width == 0 ? py::object(py::none()) : py::object(py::make_tuple(o.model_width, o.model_height));
             d["channel_order"] = std::string(model::channel_order_name(o.network_order));
             d["frame_order"] = std::string(model::channel_order_name(s.frame_order()));
             return d;
           },
           "dict: the session's iters_s16, iters_s8, model_size, channel_order and frame_order.")
-      .def("__repr__", [](const Session& s) { return "neuflow.Session(device='" + s.device() + "')"; });
+      .def("__repr__", [](Session& s) { return "neuflow.Session(device='" + s.device() + "')"; });
 
   m.def(
-      "_takes_without_copy", [](const py::handle& frame) { return frame_from(frame, model::ChannelOrder::rgb, "frame").borrowed; },
+      "_takes_without_copy",
+      [](const py::handle& frame) { return frame_from(frame, model::ChannelOrder::rgb, "frame").borrowed; },
       py::arg("frame"), "Whether a session reads this frame in place rather than copying it (for tests).");
 }
 

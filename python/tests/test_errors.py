@@ -21,6 +21,12 @@ def test_a_frame_that_is_not_uint8_hxwx3_is_a_value_error(cpu_model, camera_fram
         session.push([[1, 2, 3]])
 
 
+def test_a_frame_larger_than_the_network_takes_is_refused_before_it_is_copied(cpu_model):
+    huge = np.broadcast_to(np.uint8(0), (100_000, 100_000))  # a grey view: copying it would take 30 GB
+    with pytest.raises(ValueError, match="larger than the 16384 pixels a side"):
+        cpu_model.session().compute(huge, huge)
+
+
 def test_frames_of_different_sizes_are_a_value_error(cpu_model, camera_frames):
     a, b = camera_frames[:2]
     with pytest.raises(ValueError, match="size"):
@@ -37,7 +43,7 @@ def test_a_frame_too_small_for_the_network_is_a_value_error(cpu_model):
     ({"iters_s16": -1}, "iters_s16: expected"),
     ({"model_size": (100, 64)}, "model_size: "),
     ({"channel_order": "grb"}, 'channel_order: expected rgb or bgr, got "grb"'),
-    ({"frame_order": "yuv"}, 'channel_order: expected rgb or bgr, got "yuv"'),
+    ({"frame_order": "yuv"}, 'frame_order: expected rgb or bgr, got "yuv"'),
 ])
 def test_unusable_session_options_are_value_errors_naming_them(cpu_model, options, says):
     with pytest.raises(ValueError, match=says):
@@ -62,14 +68,21 @@ def test_a_jpeg_renamed_pth_is_a_model_error(tmp_path):
         neuflow.Model(fake, backend="cpu")
 
 
-def test_a_missing_checkpoint_is_an_os_error(tmp_path):
-    with pytest.raises(OSError, match="no such file"):
+def test_a_missing_checkpoint_is_a_file_not_found_error(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no such file"):
         neuflow.Model(tmp_path / "missing.pth", backend="cpu")
+    with pytest.raises(OSError) as raised:
+        neuflow.Model(tmp_path, backend="cpu")  # a folder: there, but not a file
+    assert not isinstance(raised.value, FileNotFoundError)
 
 
 def test_flow_files_that_cannot_be_read_raise_os_errors(tmp_path):
     with pytest.raises(FileNotFoundError, match="missing.flo"):
         neuflow.read_flow(tmp_path / "missing.flo")
+    (tmp_path / "folder.flo").mkdir()
+    with pytest.raises(OSError, match="folder.flo") as raised:
+        neuflow.read_flow(tmp_path / "folder.flo")
+    assert not isinstance(raised.value, FileNotFoundError)
     (tmp_path / "bad.flo").write_bytes(b"PIEH\x00\x00")
     with pytest.raises(OSError, match="bad.flo"):
         neuflow.read_flow(tmp_path / "bad.flo")

@@ -21,6 +21,7 @@ def run(*args):
 
 
 def test_evaluate_gives_neuflow_evals_figures(checkpoint, cli, tmp_path):
+    pytest.importorskip("cv2")
     sequence = require("flow-gt/middlebury/RubberWhale")
     for folder, names in (("other-data", ["frame10.png", "frame11.png"]), ("other-gt-flow", ["flow10.flo"])):
         (tmp_path / folder / "RubberWhale").mkdir(parents=True)

@@ -54,6 +54,15 @@ def test_ground_truth_files_of_the_benchmarks_read(tmp_path):
     assert 0 < np.isfinite(kitti[..., 0]).mean() < 1  # sparse
 
 
+def test_any_nonzero_mask_value_is_valid(tmp_path):
+    flow = random_flow(4, 4)
+    valid = np.full((4, 4), 256, dtype=np.int32)  # nonzero, though 0 modulo 256
+    valid[0, 0] = 0
+    neuflow.write_flow(tmp_path / "f.flo", flow, valid=valid)
+    back = neuflow.read_flow(tmp_path / "f.flo")
+    assert np.isnan(back[0, 0]).all() and np.isfinite(back[1:]).all()
+
+
 def test_float64_flow_is_taken_as_float32(tmp_path):
     flow = random_flow().astype(np.float64)
     neuflow.write_flow(tmp_path / "f.flo", flow)
