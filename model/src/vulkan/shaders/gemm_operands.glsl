@@ -59,20 +59,61 @@ float gemm_a(int m, int k) {
 #endif
 }
 
-// B[k][column], 0 outside the matrix (and in a convolution's padding).
-float gemm_b(GemmColumn c, int k) {
-  if (!c.ok || k >= gemm_k()) return 0.0;
-#if defined(IMPLICIT_CONV)
-  const int kk2 = p.kernel * p.kernel;
-  const int ci = k / kk2, rem = k - ci * kk2;
-  const int ky = rem / p.kernel, kx = rem - ky * p.kernel;
-  const int iy = c.iy0 + ky, ix = c.ix0 + kx;
-  if (iy < 0 || iy >= p.in_h || ix < 0 || ix >= p.in_w) return 0.0;
-  return float(b_data[p.in_off + ci * p.in_h * p.in_w + iy * p.in_w + ix]);
-#elif defined(WINOGRAD_GEMM)
-  return b_data[(int(gl_WorkGroupID.z) * gemm_k() + k) * gemm_n() + c.n];
+// Where an invocation is along K as it gathers B: for a convolution, k's input channel and tap
+// (k = (ci · kernel + ky) · kernel + kx), kept by additions as k moves, so that no gathered
+// element pays the two integer divisions that finding them from k takes (tens of instructions
+// each on a GPU, and scalar ones on a CPU's vector units).
+struct GemmCursor {
+  int k;
+  int ci, ky, kx;
+};
+
+GemmCursor gemm_cursor(int k) {
+  GemmCursor c;
+  c.k = k;
+#ifdef IMPLICIT_CONV
+  const int taps = p.kernel * p.kernel;
+  c.ci = k / taps;
+  const int rem = k - c.ci * taps;
+  c.ky = rem / p.kernel;
+  c.kx = rem - c.ky * p.kernel;
 #else
-  return float(b_data[p.b_off + k * p.b_rs + c.n * p.b_cs]);
+  c.ci = 0;
+  c.ky = 0;
+  c.kx = 0;
+#endif
+  return c;
+}
+
+// The cursor `step` further along K, `step` decomposed once by gemm_cursor(step).
+void gemm_advance(inout GemmCursor c, GemmCursor step) {
+  c.k += step.k;
+#ifdef IMPLICIT_CONV
+  c.kx += step.kx;
+  if (c.kx >= p.kernel) {
+    c.kx -= p.kernel;
+    ++c.ky;
+  }
+  c.ky += step.ky;
+  if (c.ky >= p.kernel) {
+    c.ky -= p.kernel;
+    ++c.ci;
+  }
+  c.ci += step.ci;
+#endif
+}
+
+// B[k][column] at the cursor's k, 0 outside the matrix (and in a convolution's padding).
+float gemm_b(GemmColumn col, GemmCursor c) {
+  if (!col.ok || c.k >= gemm_k()) return 0.0;
+#if defined(IMPLICIT_CONV)
+  const int iy = col.iy0 + c.ky, ix = col.ix0 + c.kx;
+  if (iy < 0 || iy >= p.in_h || ix < 0 || ix >= p.in_w) return 0.0;
+  return float(b_data[p.in_off + (c.ci * p.in_h + iy) * p.in_w + ix]);
+#elif defined(WINOGRAD_GEMM)
+  return b_data[(int(gl_WorkGroupID.z) * gemm_k() + c.k) * gemm_n() + col.n];
+#else
+  return float(b_data[p.b_off + c.k * p.b_rs + col.n * p.b_cs]);
 #endif
 }
 

@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #include "precision.glsl"
 // C = act(alpha · A · B + bias + addend) in fp32 scalar arithmetic, tiled through workgroup
-// memory: 64×64 outputs per workgroup, 4×4 per invocation, K in steps of 16. Compiled for
+// memory: 64×64 outputs per workgroup, 4×4 per invocation, K in steps of 16, the next step's
+// operands loaded into registers while the current step's are multiplied. Compiled for
 // the three kinds of product of gemm_operands.glsl (IMPLICIT_CONV, WINOGRAD_GEMM, strided).
 // Every device runs it; matmul_fragments.comp is the tensor-core path of the same products.
 layout(local_size_x = 16, local_size_y = 16) in;
@@ -28,7 +29,9 @@ layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the ad
 #include "gemm_operands.glsl"
 
 const int BM = 64, BN = 64, BK = 16;
-shared float tile_a[BK][BM];
+// tile_a's rows padded by one: the 16 invocations that store a column's 16 k values (adjacent
+// in the weights) then write 16 different banks, where a 64-float row put them all in one.
+shared float tile_a[BK][BM + 1];
 shared float tile_b[BK][BN];
 
 void main() {
@@ -37,26 +40,49 @@ void main() {
   const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
   const int col0 = int(gl_WorkGroupID.x) * BN;  // columns of C (output pixels)
   const int K = gemm_k();
-  // The column this invocation gathers for B: fixed across the K loop (256 % 64 == 0).
-  const GemmColumn column = gemm_column(col0 + (tid % BN));
+  // B: each invocation gathers one column (fixed across the K loop) at 4 consecutive k of each
+  // step, followed by a cursor, so no gathered element divides.
+  const GemmColumn column = gemm_column(col0 + tid % BN);
+  const int b_row = 4 * (tid / BN);
+  GemmCursor b_at = gemm_cursor(b_row);
+  const GemmCursor one = gemm_cursor(1), step = gemm_cursor(BK);
 
   float acc[4][4];
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) acc[i][j] = 0.0;
 
+  // The next step's operands wait in registers while this step's are multiplied (a GPU hides
+  // the global loads' latency behind the arithmetic that way), then go to workgroup memory.
+  float next_a[4], next_b[4];
+  for (int r = 0; r < 4; ++r) {
+    const int e = tid + 256 * r;  // A: 64 rows × 16 k, adjacent invocations adjacent k
+    next_a[r] = gemm_a(row0 + e / BK, e % BK);
+  }
+  GemmCursor c = b_at;
+  for (int r = 0; r < 4; ++r) {
+    next_b[r] = gemm_b(column, c);
+    gemm_advance(c, one);
+  }
+
   for (int k0 = 0; k0 < K; k0 += BK) {
-    // A tile: 64 rows × 16 k, adjacent invocations read adjacent k (row-major weights).
     for (int r = 0; r < 4; ++r) {
       const int e = tid + 256 * r;
-      const int kk = e % BK, mm = e / BK;
-      tile_a[kk][mm] = gemm_a(row0 + mm, k0 + kk);
-    }
-    // B tile: 16 k × 64 columns, adjacent invocations read adjacent columns.
-    for (int r = 0; r < 4; ++r) {
-      const int kk = tid / BN + 4 * r;
-      tile_b[kk][tid % BN] = gemm_b(column, k0 + kk);
+      tile_a[e % BK][e / BK] = next_a[r];
+      tile_b[b_row + r][tid % BN] = next_b[r];
     }
     barrier();
+    if (k0 + BK < K) {
+      for (int r = 0; r < 4; ++r) {
+        const int e = tid + 256 * r;
+        next_a[r] = gemm_a(row0 + e / BK, k0 + BK + e % BK);
+      }
+      gemm_advance(b_at, step);
+      c = b_at;
+      for (int r = 0; r < 4; ++r) {
+        next_b[r] = gemm_b(column, c);
+        gemm_advance(c, one);
+      }
+    }
     for (int kk = 0; kk < BK; ++kk) {
       float av[4], bv[4];
       for (int i = 0; i < 4; ++i) av[i] = tile_a[kk][ty + 16 * i];

@@ -60,8 +60,12 @@ void main() {
   const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
   const int col0 = int(gl_WorkGroupID.x) * BN;  // columns of C (output pixels)
   const int K = gemm_k();
-  // B is gathered by column, each invocation the same column through the K loop.
+  // B is gathered by column, each invocation the same column through the K loop, at 16
+  // consecutive k of each step, followed by a cursor (no gathered element divides).
   const GemmColumn column = gemm_column(col0 + tid % BN);
+  const int b_row = 16 * (tid / BN);
+  GemmCursor b_at = gemm_cursor(b_row);
+  const GemmCursor one = gemm_cursor(1), step = gemm_cursor(BK);
 #ifdef TENSOR_CORES
   const int warp = int(gl_SubgroupID);
 #else
@@ -89,10 +93,12 @@ void main() {
       tile_a[mm * SA + kk] = float16_t(gemm_a(row0 + mm, k0 + kk));
     }
     // B: 32 k × 64 columns, adjacent invocations read adjacent columns.
+    GemmCursor c = b_at;
     for (int r = 0; r < 16; ++r) {
-      const int kk = tid / BN + 2 * r;
-      tile_b[kk * SB + tid % BN] = float16_t(gemm_b(column, k0 + kk));
+      tile_b[(b_row + r) * SB + tid % BN] = float16_t(gemm_b(column, c));
+      gemm_advance(c, one);
     }
+    gemm_advance(b_at, step);
     barrier();
     for (int kf = 0; kf < BK; kf += F) {
 #ifdef TENSOR_CORES
