@@ -116,7 +116,7 @@ py::array_t<float> array_from(flow::FlowField&& field) {
   }
   float* data = owner->data();
   py::capsule free_when_done(owner.get(), [](void* p) { delete static_cast<std::vector<float>*>(p); });
-  owner.release();
+  static_cast<void>(owner.release());  // the capsule frees it now
   const py::ssize_t h = field.height, w = field.width;
   return py::array_t<float>(
       {h, w, py::ssize_t{2}},

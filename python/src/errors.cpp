@@ -23,7 +23,8 @@ void bind_errors(py::module_& m) {
   static auto& backend_error = *new py::exception<model::BackendError>(m, "BackendError", PyExc_RuntimeError);
   model_error.doc() = "The file is not a NeuFlow-V2 checkpoint the core can load (the message says why).";
   backend_error.doc() = "The Vulkan backend cannot run: no device, out of memory, a lost device.";
-  py::register_exception_translator([](std::exception_ptr p) {
+  // By value: pybind11's translators are void(*)(std::exception_ptr).
+  py::register_exception_translator([](std::exception_ptr p) {  // NOLINT(performance-unnecessary-value-param)
     try {
       if (p) std::rethrow_exception(p);
     } catch (const model::CheckpointError& e) {
