@@ -207,7 +207,7 @@ TEST_F(VulkanWork, OnTensorCoresAWinogradLayerIsOneDispatch) {
   print("fp16 Winograd at 160x128, scalar", scalar);
   print("fp16 Winograd at 160x128, tensor cores (twin), fused", fused);
   print("fp16 Winograd at 160x128, tensor cores (twin), split", split);
-  const int layers = test::dispatches_of(fused, "winograd_conv_coopmat_twin");
+  const long layers = test::dispatches_of(fused, "winograd_conv_coopmat_twin");
   EXPECT_EQ(layers, test::dispatches_of(scalar, "winograd_conv"));
   EXPECT_GT(layers, 0);
   EXPECT_EQ(fused.dispatches, scalar.dispatches);
