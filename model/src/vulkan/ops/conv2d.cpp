@@ -5,61 +5,54 @@ namespace neuflow::model::vulkan {
 
 namespace {
 
+// The parameters of both one-dispatch forms: winograd_conv.comp reads the OIHW filters at w_off,
+// winograd_conv_fragments.comp the filters transformed at upload.
+WinogradConvParams winograd_conv_params(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in,
+                                        const View& out, const View& addend) {
+  const DeviceConv& w = *op.weights;
+  const int tiles_x = winograd_tiles(out.w);
+  return WinogradConvParams{in.c,
+                            in.h,
+                            in.w,
+                            in.offset(),
+                            out.c,
+                            out.offset(),
+                            tiles_x,
+                            tiles_x * winograd_tiles(out.h),
+                            w.weight.offset,
+                            r.device_weights().winograd_filters_of(w),
+                            winograd_filter_side(in.c),
+                            winograd_filter_side(out.c),
+                            w.bias.offset,
+                            op.addend ? addend.offset() : -1,
+                            activation_code(op.act)};
+}
+
 // F(4×4, 3×3) in one dispatch (winograd_conv.comp): the filters and tiles transformed as they
 // are loaded, the products transformed back with bias, addend and activation as they are
 // stored. It reads what the direct convolution reads (`read` values) and writes what it writes.
 void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
                            const View& addend, long long read) {
-  const DeviceConv& w = *op.weights;
-  const int tiles_x = winograd_tiles(out.w), tile_count = tiles_x * winograd_tiles(out.h);
-  const WinogradConvParams p{in.c,
-                             in.h,
-                             in.w,
-                             in.offset(),
-                             out.c,
-                             out.offset(),
-                             tiles_x,
-                             tile_count,
-                             w.weight.offset,
-                             w.bias.offset,
-                             op.addend ? addend.offset() : -1,
-                             activation_code(op.act)};
+  const WinogradConvParams p = winograd_conv_params(r, op, in, out, addend);
   const long long points = 36LL * out.c * in.c;
   r.dispatch<Shader::winograd_conv>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
-                                    {r.bytes(read), r.bytes(out.count()), points * tile_count},
-                                    tiles(tile_count, "a convolution", 32), tiles(out.c, "a convolution", 16));
+                                    {r.bytes(read), r.bytes(out.count()), points * p.tiles},
+                                    tiles(p.tiles, "a convolution", 32), tiles(out.c, "a convolution", 16));
 }
 
 // F(4×4, 3×3) in one dispatch with the products on fragments (winograd_conv_fragments.comp, on
 // tensor cores or their twin): the tiles transformed as they are loaded, the filters as
 // transformed at upload (fp16, padded to 16), the products transformed back with bias, addend
-// and activation as they are stored.
+// and activation as they are stored. `activations`: the input, bias and addend values it reads
+// besides the filters.
 void record_winograd_fragments(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
-                               const View& addend) {
-  const DeviceConv& w = *op.weights;
-  const int tiles_x = winograd_tiles(out.w), tile_count = tiles_x * winograd_tiles(out.h);
-  const int side_in = winograd_filter_side(in.c), side_out = winograd_filter_side(out.c);
-  const WinogradConvFragmentsParams p{in.c,
-                                      in.h,
-                                      in.w,
-                                      in.offset(),
-                                      out.c,
-                                      out.offset(),
-                                      tiles_x,
-                                      tile_count,
-                                      r.device_weights().winograd_filters_of(w),
-                                      side_in,
-                                      side_out,
-                                      w.bias.offset,
-                                      op.addend ? addend.offset() : -1,
-                                      activation_code(op.act)};
-  const long long filters = 36LL * side_out * side_in;  // fp16, as the fragments load them
-  const long long read =
-      r.bytes(in.count() + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0)) + filters * 2;
+                               const View& addend, long long activations) {
+  const WinogradConvParams p = winograd_conv_params(r, op, in, out, addend);
+  const long long filters = 36LL * p.filters_out * p.filters_in;  // fp16, as the fragments load them
   r.record_dispatch(product_shader(Shader::winograd_conv, r.product_kernels()),
                     {&r.weights(), in.buffer, out.buffer, addend.buffer, &r.device_weights().winograd_buffer}, &p,
-                    sizeof p, {read, r.bytes(out.count()), 36LL * out.c * in.c * tile_count},
-                    {tiles(tile_count, "a convolution", 16), tiles(out.c, "a convolution", 16), 1});
+                    sizeof p, {r.bytes(activations) + filters * 2, r.bytes(out.count()), 36LL * out.c * in.c * p.tiles},
+                    {tiles(p.tiles, "a convolution", 16), tiles(out.c, "a convolution", 16), 1});
 }
 
 // F(4×4, 3×3) in three dispatches: the input tiles transformed, 36 products of the filters
@@ -108,12 +101,13 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
   const View in = r.view(op.in), out = r.view(op.out);
   const View addend = op.addend ? r.view(*op.addend) : View{};
   const long long taps = static_cast<long long>(in.c) * w.kernel_h * w.kernel_w;
-  const long long read = in.count() + taps * out.c + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
+  const long long activations = in.count() + (w.bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
+  const long long read = activations + taps * out.c;
   if (takes_winograd(r.conv_algorithm(), op, out.h, out.w)) {
     if (r.conv_algorithm() == ConvAlgorithm::winograd_split) {
       record_winograd(r, op, in, out, addend);
     } else if (r.product_kernels() != ProductKernels::scalar) {
-      record_winograd_fragments(r, op, in, out, addend);
+      record_winograd_fragments(r, op, in, out, addend, activations);
     } else {
       record_winograd_fused(r, op, in, out, addend, read);
     }

@@ -32,7 +32,7 @@ layout(std430, binding = 1) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 layout(std430, binding = 4) readonly buffer Filters { float16_t filters[]; };
-#include "params/winograd_conv_fragments_params.h"
+#include "params/winograd_conv_params.h"
 #include "activate.glsl"
 #define READS_INPUT_TILES
 #include "winograd_tile_io.glsl"
