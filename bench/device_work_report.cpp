@@ -10,10 +10,11 @@ namespace {
 constexpr double kMB = 1e6;
 
 struct Totals {
-  int commands = 0;
+  int commands = 0, barriers = 0;
   std::uint64_t workgroups = 0, read = 0, written = 0, multiply_adds = 0;
   void add(const model::DeviceCommand& c) {
     ++commands;
+    barriers += c.after_barrier ? 1 : 0;
     workgroups += c.workgroups;
     read += c.bytes_read;
     written += c.bytes_written;
@@ -22,8 +23,8 @@ struct Totals {
 };
 
 void print_row(std::FILE* out, const std::string& kernel, const std::string& stage, const Totals& t) {
-  std::fprintf(out, "  %-18s %-22s %5d %10llu %11.3f %11.3f %12.3f\n", kernel.c_str(), stage.c_str(), t.commands,
-               static_cast<unsigned long long>(t.workgroups), static_cast<double>(t.read) / kMB,
+  std::fprintf(out, "  %-26s %-22s %5d %5d %10llu %11.3f %11.3f %12.3f\n", kernel.c_str(), stage.c_str(), t.commands,
+               t.barriers, static_cast<unsigned long long>(t.workgroups), static_cast<double>(t.read) / kMB,
                static_cast<double>(t.written) / kMB, static_cast<double>(t.multiply_adds) / 1e6);
 }
 
@@ -44,8 +45,9 @@ void print_work_table(std::FILE* out, const std::string& title, const model::Dev
   std::fprintf(out, "\n%s: %d dispatches, %d copies, %d barriers, %d timestamps, %d submissions, %d host waits\n",
                title.c_str(), work.dispatches, work.copies, work.barriers, work.timestamps, work.submissions,
                work.host_waits);
-  std::fprintf(out, "  %-18s %-22s %5s %10s %11s %11s %12s\n", "kernel", "stage", "cmds", "workgroups", "read MB",
-               "written MB", "M mult-adds");
+  // waits: commands with a pipeline barrier before them.
+  std::fprintf(out, "  %-26s %-22s %5s %5s %10s %11s %11s %12s\n", "kernel", "stage", "cmds", "waits", "workgroups",
+               "read MB", "written MB", "M mult-adds");
   std::vector<std::string> stages;  // in the order they ran
   std::map<std::string, Totals> by_stage;
   Totals all;

@@ -2,6 +2,7 @@
 // tensors and op ids do not depend on the iterations, and the memory planned from its live
 // ranges never gives two tensors that are alive at once the same bytes.
 #include <gtest/gtest.h>
+#include <array>
 
 #include <cstdio>
 #include <random>
@@ -142,6 +143,35 @@ TEST(MemoryPlan, RegionsHoldOnlyTensorsNeverAliveAtOnceAtAnyIterations) {
   std::printf("planned %zu regions, %.1f M values; one buffer per tensor: %.1f M values\n", plan.region_size.size(),
               static_cast<double>(plan.planned_size()) / 1e6, static_cast<double>(separate) / 1e6);
   EXPECT_LT(plan.planned_size(), separate / 2);
+  // As the Vulkan backend plans it: no region shared by tensors within two ops of each other.
+  const graph::MemoryPlan apart = graph::plan_memory(planned.tensors, ranges, 2);
+  EXPECT_NO_THROW(graph::check_plan(planned.tensors, apart, ranges));
+  std::printf("two ops apart: %zu regions, %.1f M values\n", apart.region_size.size(),
+              static_cast<double>(apart.planned_size()) / 1e6);
+  EXPECT_LT(apart.planned_size(), separate / 2);
+}
+
+// a → b and c → d side by side: packed tightly, c could take a's region and be written right
+// after a is last read, which a GPU must order with a barrier. Two ops apart, it cannot.
+TEST(MemoryPlan, TensorsOpsApartNeverShareARegion) {
+  graph::TensorTable tensors;
+  std::array<graph::TensorId, 4> ids{};
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    ids[i] = tensors.add({std::string(1, static_cast<char>('a' + i)), 2, 4, 4});
+  }
+  const auto [a, b, c, d] = ids;
+  graph::OpList<Host> pass{{0, graph::Zero{tensors.all(a)}},   {1, graph::Copy{tensors.all(a), tensors.all(b)}},
+                           {2, graph::Zero{tensors.all(c)}},   {3, graph::Copy{tensors.all(c), tensors.all(d)}},
+                           {4, graph::Output{tensors.all(b)}}, {5, graph::Output{tensors.all(d)}}};
+  const auto ranges = graph::live_ranges<Host>(tensors, {&pass});
+  const auto region = [](const graph::MemoryPlan& plan, graph::TensorId t) {
+    return plan.region[static_cast<std::size_t>(t)];
+  };
+  const graph::MemoryPlan tight = graph::plan_memory(tensors, ranges);
+  EXPECT_EQ(region(tight, c), region(tight, a)) << "a is dead once op 1 has read it";
+  const graph::MemoryPlan apart = graph::plan_memory(tensors, ranges, 2);
+  EXPECT_NE(region(apart, c), region(apart, a));
+  EXPECT_NO_THROW(graph::check_plan(tensors, apart, ranges));
 }
 
 TEST(MemoryPlan, AStepsTemporariesLiveWithinTheStep) {

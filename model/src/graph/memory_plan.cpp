@@ -15,6 +15,16 @@ bool planned(const TensorDesc& d) { return d.storage == Storage::transient; }
 
 bool meet(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) { return live_at_once(a, b); }
 
+// Whether a's and b's ranges meet or come within `apart` ops of each other.
+bool near(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b, int apart) {
+  for (const LiveRange& x : a) {
+    for (const LiveRange& y : b) {
+      if (x.first <= y.last + apart && y.first <= x.last + apart) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 bool live_at_once(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) {
@@ -100,7 +110,7 @@ std::size_t MemoryPlan::planned_size() const {
   return std::accumulate(region_size.begin(), region_size.end(), std::size_t{0});
 }
 
-MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges) {
+MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges, int apart) {
   MemoryPlan plan;
   plan.region.assign(tensors.size(), -1);
   std::vector<TensorId> order;
@@ -118,7 +128,7 @@ MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges) {
     std::size_t best_growth = std::numeric_limits<std::size_t>::max(), best_size = 0;
     for (std::size_t r = 0; r < members.size(); ++r) {
       const bool free = std::none_of(members[r].begin(), members[r].end(), [&](TensorId other) {
-        return meet(ranges[static_cast<std::size_t>(t)], ranges[static_cast<std::size_t>(other)]);
+        return near(ranges[static_cast<std::size_t>(t)], ranges[static_cast<std::size_t>(other)], apart);
       });
       if (!free) continue;
       const std::size_t size = plan.region_size[r];

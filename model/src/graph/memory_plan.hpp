@@ -33,8 +33,10 @@ struct MemoryPlan {
 };
 
 // Greedy: tensors in the order they are first written, each into the smallest region whose
-// tensors' ranges it does not meet and that needs the least growth.
-MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges);
+// tensors' ranges it does not meet and that needs the least growth. `apart`: a region's tensors'
+// ranges are also at least that many ops apart, so that ops that close to each other never
+// write what the other reads in one buffer (a GPU runs them without a barrier between them).
+MemoryPlan plan_memory(const TensorTable& tensors, const LiveRanges& ranges, int apart = 0);
 
 // Offsets in one allocation (a CPU's): each block of bytes at the lowest offset, aligned, free
 // throughout its ranges; the largest blocks placed first, which leaves less unused between them

@@ -45,11 +45,29 @@ class Builder {
   }
 
   // ConvBlock: conv (k×k, stride, pad) → LeakyReLU → conv 3×3 → LeakyReLU, BatchNorms folded.
+  struct ConvBlock {
+    const BasicConvBlockWeights<T>* weights;
+    std::string layer;
+    Slice in;
+    int stride, pad;
+    Slice out;
+  };
   void conv_block(const BasicConvBlockWeights<T>& w, const std::string& layer, Slice in, int stride, int pad,
                   Slice out) {
-    const TensorId mid = like(layer + ".conv1", w.conv1.out_channels, out.tensor);
-    conv(w.conv1, layer + ".conv1", in, all(mid), stride, pad, Activation::leaky_relu);
-    conv(w.conv2, layer + ".conv2", all(mid), out, 1, 1, Activation::leaky_relu);
+    conv_blocks({ConvBlock{&w, layer, in, stride, pad, out}});
+  }
+  // ConvBlocks of inputs independent of each other: their first convolutions next to each other,
+  // then their second, so that a GPU runs each pair without a barrier between them.
+  void conv_blocks(const std::vector<ConvBlock>& blocks) {
+    std::vector<TensorId> mids;
+    for (const ConvBlock& b : blocks) {
+      mids.push_back(like(b.layer + ".conv1", b.weights->conv1.out_channels, b.out.tensor));
+      conv(b.weights->conv1, b.layer + ".conv1", b.in, all(mids.back()), b.stride, b.pad, Activation::leaky_relu);
+    }
+    for (std::size_t i = 0; i < blocks.size(); ++i) {
+      const ConvBlock& b = blocks[i];
+      conv(b.weights->conv2, b.layer + ".conv2", all(mids[i]), b.out, 1, 1, Activation::leaky_relu);
+    }
   }
 
   // One cross-attention layer on `source`, which holds both frames' tokens (frame 0's rows above
@@ -61,17 +79,18 @@ class Builder {
                        TensorId out) {
     const TensorId qkv = like(layer + ".qkv", 3 * kFeatureChannels, source);
     linear(w.qkv_proj, layer + ".qkv_proj", all(source), all(qkv));
+    // The MLP's input is concat[source, LayerNorm1(merged)]; the source's half is copied beside
+    // the projection, which it does not depend on.
+    const TensorId mlp_in = like(layer + ".mlp_input", 2 * kFeatureChannels, source);
+    emit(Copy{all(source), all(mlp_in).channels(0, kFeatureChannels)});
     const TensorId message = like(layer + ".message", kFeatureChannels, source);
     emit(Attention{all(qkv).channels(0, kFeatureChannels), all(qkv).channels(kFeatureChannels, kFeatureChannels),
                    all(qkv).channels(2 * kFeatureChannels, kFeatureChannels), all(message), scores(), block_rows_,
                    true});
     const TensorId merged = like(layer + ".merge", kFeatureChannels, source);
     linear(w.merge, layer + ".merge", all(message), all(merged));
-    // The MLP's input is concat[source, LayerNorm1(merged)].
-    const TensorId mlp_in = like(layer + ".mlp_input", 2 * kFeatureChannels, source);
     emit(LayerNorm<T>{&w.norm1, layer + ".norm1", all(merged), all(mlp_in).channels(kFeatureChannels, kFeatureChannels),
                       std::nullopt});
-    emit(Copy{all(source), all(mlp_in).channels(0, kFeatureChannels)});
     const TensorId hidden = like(layer + ".mlp.0", 2 * kFeatureChannels, source);
     linear(w.mlp0, layer + ".mlp.0", all(mlp_in), all(hidden), Activation::gelu);
     const TensorId mlp_out = like(layer + ".mlp.2", kFeatureChannels, source);
@@ -209,13 +228,13 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   b.conv_block(w.conv_s8, "conv_s8", b.all(input), 8, 0, b.all(encoded.up));
   b.emit(StageEnd{str(stage::conv_s8), {}});
   const TensorId cat8 = b.tensor("backbone.cat_8", 384, h8, w8);
-  b.conv_block(w.block_8_1, "backbone.block_8_1", b.all(half), 4, 2, b.all(cat8).channels(0, 256));
-  b.conv_block(w.block_8_2, "backbone.block_8_2", b.all(quarter), 2, 2, b.all(cat8).channels(256, 128));
+  b.conv_blocks({{&w.block_8_1, "backbone.block_8_1", b.all(half), 4, 2, b.all(cat8).channels(0, 256)},
+                 {&w.block_8_2, "backbone.block_8_2", b.all(quarter), 2, 2, b.all(cat8).channels(256, 128)}});
   b.conv_block(w.block_cat_8, "backbone.block_cat_8", b.all(cat8), 1, 1, b.all(encoded.f8));
   b.emit(StageEnd{str(stage::backbone_s8), {}});
   const TensorId cat16 = b.tensor("backbone.cat_16", 256, h16, w16);
-  b.conv_block(w.block_16_1, "backbone.block_16_1", b.all(eighth), 2, 2, b.all(cat16).channels(0, 128));
-  b.conv_block(w.block_8_16, "backbone.block_8_16", b.all(encoded.f8), 2, 2, b.all(cat16).channels(128, 128));
+  b.conv_blocks({{&w.block_16_1, "backbone.block_16_1", b.all(eighth), 2, 2, b.all(cat16).channels(0, 128)},
+                 {&w.block_8_16, "backbone.block_8_16", b.all(encoded.f8), 2, 2, b.all(cat16).channels(128, 128)}});
   b.conv_block(w.block_cat_16, "backbone.block_cat_16", b.all(cat16), 1, 1,
                b.all(encoded.f16).channels(0, kBackbone16Channels));
   b.emit(StageEnd{str(stage::backbone_s16), {}});
@@ -263,18 +282,28 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   // 1/16 → 1/8: the flow, each frame's features merged with its attended ones, the context.
   const TensorId flow8 = b.tensor("flow_s8", 2, h8, w8);
   b.emit(Resample{b.all(flow16), b.all(flow8), 2, false, 2.f});
-  std::array<TensorId, 2> merged{};
+  // The two frames' ops side by side, step by step: a GPU runs each step of both without a
+  // barrier between them.
+  std::array<TensorId, 2> merged{}, merge_in{}, merge_mid{};
   const std::array<std::pair<TensorId, TensorId>, 2> pair{{{first.f8, att0}, {second.f8, att1}}};
   for (std::size_t f = 0; f < 2; ++f) {
     const std::string at = "merge_s8.frame" + std::to_string(f);
-    const TensorId in = b.tensor(at + ".input", 2 * kMatchingChannels, h8, w8);
-    b.emit(Copy{features_of(pair[f].first), b.all(in).channels(0, kMatchingChannels)});
-    b.emit(
-        Resample{features_of(pair[f].second), b.all(in).channels(kMatchingChannels, kMatchingChannels), 2, false, 1.f});
-    const TensorId mid = b.tensor(at + ".0", kMatchingChannels, h8, w8);
-    b.conv(w.merge_s8_0, "merge_s8.0", b.all(in), b.all(mid), 1, 1, Activation::gelu);
+    merge_in[f] = b.tensor(at + ".input", 2 * kMatchingChannels, h8, w8);
+    merge_mid[f] = b.tensor(at + ".0", kMatchingChannels, h8, w8);
     merged[f] = b.tensor(at, kMatchingChannels, h8, w8);
-    b.conv(w.merge_s8_2, "merge_s8.2", b.all(mid), b.all(merged[f]), 1, 1, Activation::none);
+  }
+  for (std::size_t f = 0; f < 2; ++f) {
+    b.emit(Copy{features_of(pair[f].first), b.all(merge_in[f]).channels(0, kMatchingChannels)});
+  }
+  for (std::size_t f = 0; f < 2; ++f) {
+    b.emit(Resample{features_of(pair[f].second), b.all(merge_in[f]).channels(kMatchingChannels, kMatchingChannels), 2,
+                    false, 1.f});
+  }
+  for (std::size_t f = 0; f < 2; ++f) {
+    b.conv(w.merge_s8_0, "merge_s8.0", b.all(merge_in[f]), b.all(merge_mid[f]), 1, 1, Activation::gelu);
+  }
+  for (std::size_t f = 0; f < 2; ++f) {
+    b.conv(w.merge_s8_2, "merge_s8.2", b.all(merge_mid[f]), b.all(merged[f]), 1, 1, Activation::none);
   }
   b.emit(StageEnd{str(stage::merge_s8),
                   {{str(stage::merge_s8), 0, b.all(merged[0])}, {str(stage::merge_s8), 1, b.all(merged[1])}}});

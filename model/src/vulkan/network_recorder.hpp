@@ -305,6 +305,7 @@ class VulkanNetwork::Recorder {
     for (const Span& b : writes) depends = depends || in(written_, b) || in(read_, b);
     if (depends) {
       barrier();
+      barrier_before_ = true;
       written_.clear();
       read_.clear();
       after_unknown_ = false;
@@ -338,7 +339,9 @@ class VulkanNetwork::Recorder {
                               workgroups,
                               static_cast<std::uint64_t>(w.read),
                               static_cast<std::uint64_t>(w.written),
-                              static_cast<std::uint64_t>(w.multiply_adds)});
+                              static_cast<std::uint64_t>(w.multiply_adds),
+                              barrier_before_});
+    barrier_before_ = false;
   }
 
   void write_timestamp(uint32_t query) {
@@ -359,6 +362,7 @@ class VulkanNetwork::Recorder {
   // ran before (a recording's start), so the next command waits for all of it.
   std::vector<Span> written_, read_;
   bool after_unknown_ = true;
+  bool barrier_before_ = false;  // the command being recorded waits for those before it
   std::array<int, 3> frames_{-1, -1, -1};
   const FrameLayout* frame_layout_ = nullptr;
   std::vector<float> nhwc_;

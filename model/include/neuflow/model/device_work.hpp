@@ -16,6 +16,7 @@ struct DeviceCommand {
   // The tensors it reads and writes, each once: what a kernel with perfect reuse would move.
   std::uint64_t bytes_read = 0, bytes_written = 0;
   std::uint64_t multiply_adds = 0;  // a transform-domain algorithm counts what it computes
+  bool after_barrier = false;       // waits for the commands before it (a pipeline barrier)
 };
 
 struct DeviceWork {
