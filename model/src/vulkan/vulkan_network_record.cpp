@@ -29,18 +29,50 @@ namespace {
 // - a folded BatchNorm (ChannelAffine) on a LayerNorm's output, in that LayerNorm's dispatch,
 //   where no op between them touches the tensor;
 // - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8,
-//   and with them the 8-bit frame's conversion into that input where the pyramid follows it.
+//   and with them the 8-bit frame's conversion into that input where the pyramid follows it;
+// - both parts of a concatenation (a copy or a resample, then a resample into the channels after
+//   it), in the second's dispatch, where no op between them touches the output or changes the
+//   first part's input.
 struct Fusions {
   std::vector<bool> absorbed;
   std::vector<const graph::RefineUpdate*> update_first;                 // of a correlation
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;  // of a LayerNorm
   std::vector<bool> pyramid;                                            // starts here
+  std::vector<std::optional<graph::Resample>> concat_first;             // of a resample
 };
 
 bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
   const graph::Accesses a = std::visit([](const auto& o) { return o.accesses(); }, op);
   const auto is = [&](const graph::Slice& s) { return s.tensor == tensor; };
   return std::any_of(a.reads.begin(), a.reads.end(), is) || std::any_of(a.writes.begin(), a.writes.end(), is);
+}
+
+bool writes(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
+  const graph::Accesses a = std::visit([](const auto& o) { return o.accesses(); }, op);
+  return std::any_of(a.writes.begin(), a.writes.end(), [&](const graph::Slice& s) { return s.tensor == tensor; });
+}
+
+// A copy or a resample as the first part of a concatenation (a copy is a resample of factor 1).
+std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op) {
+  if (const auto* resample = std::get_if<graph::Resample>(&op)) return *resample;
+  if (const auto* copy = std::get_if<graph::Copy>(&op)) return graph::Resample{copy->in, copy->out, 1, false, 1.f};
+  return std::nullopt;
+}
+
+// The resample after ops[i] that writes the channels right after its output's, with nothing
+// between them touching that tensor or writing ops[i]'s input.
+std::optional<std::size_t> concat_second(const graph::OpList<DeviceTensor>& ops, std::size_t i,
+                                         const graph::Resample& first) {
+  for (std::size_t j = i + 1; j < ops.size(); ++j) {
+    if (writes(ops[j].op, first.in.tensor)) return std::nullopt;
+    if (!touches(ops[j].op, first.out.tensor)) continue;
+    const auto* second = std::get_if<graph::Resample>(&ops[j].op);
+    const bool follows = second && second->out.tensor == first.out.tensor &&
+                         second->out.channel == first.out.channel + first.out.c &&
+                         second->in.tensor != first.out.tensor;
+    return follows ? std::optional(j) : std::nullopt;
+  }
+  return std::nullopt;
 }
 
 // The three poolings from ops[i] on, where they chain and the input's sides are multiples of 8.
@@ -58,9 +90,17 @@ std::optional<std::array<const graph::AvgPool2x*, 3>> pyramid_at(const graph::Op
 
 Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, bool observing) {
   Fusions f{std::vector<bool>(ops.size()), std::vector<const graph::RefineUpdate*>(ops.size()),
-            std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()), std::vector<bool>(ops.size())};
+            std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()), std::vector<bool>(ops.size()),
+            std::vector<std::optional<graph::Resample>>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (f.absorbed[i]) continue;
+    if (const auto first = as_resample(ops[i].op); first && !f.concat_first[i]) {
+      if (const auto j = concat_second(ops, i, *first); j && !f.concat_first[*j]) {
+        f.absorbed[i] = true;
+        f.concat_first[*j] = first;
+        continue;
+      }
+    }
     if (pyramid_at(ops, tensors, i)) {
       f.pyramid[i] = true;
       f.absorbed[i + 1] = f.absorbed[i + 2] = true;
@@ -131,6 +171,8 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LocalCorrelation>(op), f.update_first[i]);
     } else if (f.affine_after[i]) {
       record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);
+    } else if (f.concat_first[i]) {
+      record_op(r, *f.concat_first[i], std::get<graph::Resample>(op));
     } else {
       std::visit([&](const auto& o) { record_op(r, o); }, op);
     }

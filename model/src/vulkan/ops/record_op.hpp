@@ -27,6 +27,9 @@ void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op,
 void record_op(Recorder& r, const graph::ChannelAffine<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::GlobalMatching& op);
 void record_op(Recorder& r, const graph::Resample& op);
+// Two resamples (a copy is one of factor 1) into consecutive channel ranges of one tensor, `second`
+// after `first`, in one dispatch: both parts of a concatenation.
+void record_op(Recorder& r, const graph::Resample& first, const graph::Resample& second);
 void record_op(Recorder& r, const graph::Copy& op);
 void record_op(Recorder& r, const graph::CopyRows& op);
 void record_op(Recorder& r, const graph::Zero& op);
