@@ -133,9 +133,11 @@ TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
 }
 
 // An unobserved pass records some ops inside others' dispatches (a refinement step's update in
-// the next step's correlation, at both scales with these iterations; the attention's BatchNorm
-// in its LayerNorm; each 8-bit frame's conversion and its pyramid's three poolings in one): its
-// flow is still the CPU's.
+// the next step's correlation, at both scales with these iterations; a scale's last update with
+// the resample of its flow that follows it; both parts of a concatenation; the attention's
+// BatchNorm in its LayerNorm; each 8-bit frame's conversion and its pyramid's three poolings in
+// one): its flow is still the CPU's, also where a scale has no steps (the 1/16 flow then goes to
+// 1/8 by itself, or the 1/16 step's update is followed by the upsampler's input).
 TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
   cv::Mat a, b;
   cv::resize(frames_[0], a, cv::Size(128, 96), 0, 0, cv::INTER_AREA);
@@ -148,6 +150,14 @@ TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
   EXPECT_LT(e.mean, 1e-3);
   EXPECT_EQ(test::dispatches_of(gpu.device_work(), "local_correlation_update"), iterations.s16 + iterations.s8 - 2);
   EXPECT_EQ(test::dispatches_of(gpu.device_work(), "frame_pyramid"), 2) << "one a frame";
+  for (const Iterations other : {Iterations{1, 0}, Iterations{0, 2}}) {
+    SCOPED_TRACE(std::to_string(other.s16) + "+" + std::to_string(other.s8));
+    FlowSession cpu_other(model_, {.iterations = other, .threads = 2, .backend = Backend::cpu});
+    FlowSession gpu_other(model_, {.iterations = other, .backend = Backend::vulkan});
+    const Errors o = compare(gpu_other.compute(view_of(a), view_of(b)), cpu_other.compute(view_of(a), view_of(b)));
+    EXPECT_LT(o.max, 1e-2);
+    EXPECT_LT(o.mean, 1e-3);
+  }
 }
 
 TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {

@@ -30,6 +30,8 @@ namespace {
 //   where no op between them touches the tensor;
 // - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8,
 //   and with them the 8-bit frame's conversion into that input where the pyramid follows it;
+// - a scale's last update, with the resample (or copy) of its new flow that follows it where only
+//   stage ends lie between them (the next scale's flow, the upsampler's input);
 // - both parts of a concatenation (a copy or a resample, then a resample into the channels after
 //   it), in the second's dispatch, where no op between them touches the output or changes the
 //   first part's input.
@@ -39,6 +41,7 @@ struct Fusions {
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;  // of a LayerNorm
   std::vector<bool> pyramid;                                            // starts here
   std::vector<std::optional<graph::Resample>> concat_first;             // of a resample
+  std::vector<std::optional<graph::Resample>> resample_after;           // of a RefineUpdate
 };
 
 bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
@@ -89,8 +92,11 @@ std::optional<std::array<const graph::AvgPool2x*, 3>> pyramid_at(const graph::Op
 }
 
 Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, bool observing) {
-  Fusions f{std::vector<bool>(ops.size()), std::vector<const graph::RefineUpdate*>(ops.size()),
-            std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()), std::vector<bool>(ops.size()),
+  Fusions f{std::vector<bool>(ops.size()),
+            std::vector<const graph::RefineUpdate*>(ops.size()),
+            std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()),
+            std::vector<bool>(ops.size()),
+            std::vector<std::optional<graph::Resample>>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (f.absorbed[i]) continue;
@@ -114,6 +120,11 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
           corr->out.tensor == update->flow_copy.tensor) {
         f.absorbed[i] = true;
         f.update_first[j] = update;
+      } else if (const auto then = j < ops.size() ? as_resample(ops[j].op) : std::nullopt;
+                 then && then->in.tensor == update->flow.tensor && then->in.channel == update->flow.channel &&
+                 then->in.c == 2 && !then->relu) {
+        f.absorbed[j] = true;
+        f.resample_after[i] = then;
       }
     } else if (const auto* affine = std::get_if<graph::ChannelAffine<DeviceTensor>>(&ops[i].op)) {
       for (std::size_t k = i; k-- > 0;) {
@@ -171,6 +182,8 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LocalCorrelation>(op), f.update_first[i]);
     } else if (f.affine_after[i]) {
       record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);
+    } else if (f.resample_after[i]) {
+      record_op(r, std::get<graph::RefineUpdate>(op), &*f.resample_after[i]);
     } else if (f.concat_first[i]) {
       record_op(r, *f.concat_first[i], std::get<graph::Resample>(op));
     } else {

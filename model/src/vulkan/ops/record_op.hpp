@@ -37,7 +37,9 @@ void record_op(Recorder& r, const graph::LocalCorrelation& op);
 // The correlation with the previous refinement step's update applied first, in one dispatch
 // (`previous` nullptr: the correlation alone).
 void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::RefineUpdate* previous);
-void record_op(Recorder& r, const graph::RefineUpdate& op);
+// `then`: a resample (or copy) of the new flow into another tensor, written in the same dispatch
+// (or nullptr).
+void record_op(Recorder& r, const graph::RefineUpdate& op, const graph::Resample* then = nullptr);
 void record_op(Recorder& r, const graph::ConvexUpsample& op);
 void record_op(Recorder& r, const graph::Output& op);
 void record_op(Recorder& r, const graph::StageEnd& op);

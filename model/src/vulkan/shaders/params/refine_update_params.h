@@ -4,7 +4,10 @@
 #include "interface.h"
 
 NEUFLOW_PUSH_CONSTANTS(RefineUpdateParams)
-  int plane, hidden_off, flow_in_off, flow_off;
+  int plane, w, hidden_off, flow_in_off, flow_off;
+  int resampled_off;  // the new flow also into binding 1 from here; < 0: not
+  int factor;         // ... upsampled by this (nearest)
+  float scale;        // ... and scaled
 NEUFLOW_PUSH_CONSTANTS_END
 
 #endif
