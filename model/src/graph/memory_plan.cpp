@@ -27,14 +27,7 @@ bool near(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b, int 
 
 }  // namespace
 
-bool live_at_once(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) {
-  for (const LiveRange& x : a) {
-    for (const LiveRange& y : b) {
-      if (x.first <= y.last && y.first <= x.last) return true;
-    }
-  }
-  return false;
-}
+bool live_at_once(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) { return near(a, b, 0); }
 
 OffsetPlan plan_offsets(const std::vector<std::size_t>& bytes, const LiveRanges& ranges, std::size_t alignment) {
   OffsetPlan plan;

@@ -44,15 +44,17 @@ struct Fusions {
   std::vector<std::optional<graph::Resample>> resample_after;           // of a RefineUpdate
 };
 
-bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
-  const graph::Accesses a = std::visit([](const auto& o) { return o.accesses(); }, op);
-  const auto is = [&](const graph::Slice& s) { return s.tensor == tensor; };
-  return std::any_of(a.reads.begin(), a.reads.end(), is) || std::any_of(a.writes.begin(), a.writes.end(), is);
+graph::Accesses accesses_of(const graph::Op<DeviceTensor>& op) {
+  return std::visit([](const auto& o) { return o.accesses(); }, op);
 }
 
-bool writes(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
-  const graph::Accesses a = std::visit([](const auto& o) { return o.accesses(); }, op);
-  return std::any_of(a.writes.begin(), a.writes.end(), [&](const graph::Slice& s) { return s.tensor == tensor; });
+bool mentions(const std::vector<graph::Slice>& slices, graph::TensorId tensor) {
+  return std::any_of(slices.begin(), slices.end(), [&](const graph::Slice& s) { return s.tensor == tensor; });
+}
+
+bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
+  const graph::Accesses a = accesses_of(op);
+  return mentions(a.reads, tensor) || mentions(a.writes, tensor);
 }
 
 // A copy or a resample as the first part of a concatenation (a copy is a resample of factor 1).
@@ -67,8 +69,9 @@ std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op) {
 std::optional<std::size_t> concat_second(const graph::OpList<DeviceTensor>& ops, std::size_t i,
                                          const graph::Resample& first) {
   for (std::size_t j = i + 1; j < ops.size(); ++j) {
-    if (writes(ops[j].op, first.in.tensor)) return std::nullopt;
-    if (!touches(ops[j].op, first.out.tensor)) continue;
+    const graph::Accesses a = accesses_of(ops[j].op);
+    if (mentions(a.writes, first.in.tensor)) return std::nullopt;
+    if (!mentions(a.reads, first.out.tensor) && !mentions(a.writes, first.out.tensor)) continue;
     const auto* second = std::get_if<graph::Resample>(&ops[j].op);
     const bool follows = second && second->out.tensor == first.out.tensor &&
                          second->out.channel == first.out.channel + first.out.c &&
