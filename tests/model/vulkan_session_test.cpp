@@ -9,8 +9,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -62,6 +64,19 @@ class VulkanSession : public ::testing::Test {
     frames_ = test::camera_frames(frames, 3, cv::Size(200, 120));  // → 208×128 padded
   }
   void TearDown() override { NEUFLOW_EXPECT_NO_VALIDATION_MESSAGES(); }
+
+  // A Vulkan session made with `variable` set to `value` is refused with an error naming the
+  // variable; the variable is unset again.
+  static void expect_refused(const char* variable, const char* value) {
+    ASSERT_EQ(setenv(variable, value, 1), 0);
+    try {
+      FlowSession bad(model_, {.backend = Backend::vulkan});
+      ADD_FAILURE() << variable << "=" << value << " was accepted";
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find(variable), std::string::npos) << error.what();
+    }
+    unsetenv(variable);
+  }
 
   static std::shared_ptr<const FlowModel> model_;
   std::vector<cv::Mat> frames_;
@@ -122,14 +137,46 @@ TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
     EXPECT_LT(e.max, 1e-2) << conv;
     EXPECT_LT(e.mean, 1e-3) << conv;
   }
-  ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", "fast", 1), 0);
-  try {
-    FlowSession bad(model_, {.backend = Backend::vulkan});
-    ADD_FAILURE() << "NEUFLOW_VULKAN_CONV=fast was accepted";
-  } catch (const std::invalid_argument& error) {
-    EXPECT_NE(std::string(error.what()).find("NEUFLOW_VULKAN_CONV"), std::string::npos) << error.what();
-  }
   unsetenv("NEUFLOW_VULKAN_CONV");
+  expect_refused("NEUFLOW_VULKAN_CONV", "fast");
+}
+
+// The scalar products (matmul.comp) in each of their tiles: 32×32, 64×64 and 128×128 outputs a
+// workgroup (NEUFLOW_VULKAN_GEMM_TILE; auto, the default every other test runs, takes them by
+// the grid). With every convolution direct, all of them but the Winograd layers' go through it,
+// and the split Winograd's 36 batched products with the largest tile. Each output's products
+// are summed in the same order at every tile size, so the flows agree to the bit, and with the
+// CPU's; a bad value is an error naming the variable.
+TEST_F(VulkanSession, EveryProductTileGivesTheSameFlowToTheBit) {
+  FlowSession cpu(model_, {.threads = 2, .backend = Backend::cpu});
+  const auto expected = cpu.compute(view_of(frames_[0]), view_of(frames_[1]));
+  const auto flow_with = [&](const char* conv, const char* tile) {
+    EXPECT_EQ(setenv("NEUFLOW_VULKAN_CONV", conv, 1), 0);
+    EXPECT_EQ(setenv("NEUFLOW_VULKAN_GEMM_TILE", tile, 1), 0);
+    FlowSession gpu(model_, {.backend = Backend::vulkan});
+    auto flow = gpu.compute(view_of(frames_[0]), view_of(frames_[1]));
+    unsetenv("NEUFLOW_VULKAN_CONV");
+    unsetenv("NEUFLOW_VULKAN_GEMM_TILE");
+    return flow;
+  };
+  // How many of the flows' values differ, bit for bit.
+  const auto differing = [](const flow::FlowField& a, const flow::FlowField& b) {
+    EXPECT_EQ(a.uv.size(), b.uv.size());
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < std::min(a.uv.size(), b.uv.size()); ++i) {
+      n += std::bit_cast<std::uint32_t>(a.uv[i]) != std::bit_cast<std::uint32_t>(b.uv[i]) ? 1 : 0;
+    }
+    return n;
+  };
+  const auto direct64 = flow_with("direct", "64");
+  const Errors e = compare(direct64, expected);
+  EXPECT_LT(e.max, 1e-2);
+  EXPECT_LT(e.mean, 1e-3);
+  for (const char* tile : {"32", "128"}) {
+    EXPECT_EQ(differing(flow_with("direct", tile), direct64), 0U) << tile << "×" << tile << " against 64×64 tiles";
+  }
+  EXPECT_EQ(differing(flow_with("winograd-split", "128"), flow_with("winograd-split", "64")), 0U);
+  expect_refused("NEUFLOW_VULKAN_GEMM_TILE", "96");
 }
 
 // An unobserved pass records some ops inside others' dispatches (a refinement step's update in

@@ -25,16 +25,19 @@
 namespace neuflow::model {
 namespace {
 
-// Sets NEUFLOW_VULKAN_PRODUCTS (and NEUFLOW_VULKAN_CONV) for the sessions made in its scope.
+// Sets NEUFLOW_VULKAN_PRODUCTS (and NEUFLOW_VULKAN_CONV) for the sessions made in its scope,
+// and the scalar products' tiles to the fragments' 64×64, so that both run the same grids.
 class ProductKernelsScope {
  public:
   explicit ProductKernelsScope(const char* products, const char* conv = "winograd") {
     setenv("NEUFLOW_VULKAN_PRODUCTS", products, 1);
     setenv("NEUFLOW_VULKAN_CONV", conv, 1);
+    setenv("NEUFLOW_VULKAN_GEMM_TILE", "64", 1);
   }
   ~ProductKernelsScope() {
     unsetenv("NEUFLOW_VULKAN_PRODUCTS");
     unsetenv("NEUFLOW_VULKAN_CONV");
+    unsetenv("NEUFLOW_VULKAN_GEMM_TILE");
   }
   ProductKernelsScope(const ProductKernelsScope&) = delete;
   ProductKernelsScope& operator=(const ProductKernelsScope&) = delete;

@@ -15,6 +15,7 @@
 #include "support/camera_frames.hpp"
 #include "support/fixtures.hpp"
 #include "support/vulkan.hpp"
+#include "vulkan/gemm_tile.hpp"
 
 namespace neuflow::model {
 namespace {
@@ -295,6 +296,30 @@ TEST_F(VulkanWork, AnObservedPassIsNotCounted) {
   cpu.push(frame(0));
   cpu.push(frame(1));
   EXPECT_TRUE(cpu.device_work().commands.empty());
+}
+
+// The scalar products' tiles at 1024×448 (NEUFLOW_VULKAN_GEMM_TILE=auto): on a GPU the largest
+// whose grid keeps 128 workgroups, else the smallest; on a CPU device one workgroup a core.
+TEST(GemmTile, ALayerTakesTheLargestTileThatKeepsTheDeviceBusy) {
+  using vulkan::gemm_tile_for;
+  const vulkan::GemmTiles gpu{0, vulkan::kGpuWideGrid}, cpu{0, 2};
+  // The upsampler's 1×1 mask layer, 512 → 576 at 128×56: 5 × 56 tiles of 128×128.
+  EXPECT_EQ(gemm_tile_for(576, 128 * 56, 1, gpu), vulkan::kGemmTile128);
+  // The 8×8 stride-8 convolution, 3 → 128 at 128×56: one row of 128 tiles is 56, 64×64 gives 224.
+  EXPECT_EQ(gemm_tile_for(128, 128 * 56, 1, gpu), vulkan::kGemmTile64);
+  EXPECT_EQ(gemm_tile_for(128, 128 * 56, 1, cpu), vulkan::kGemmTile128);
+  // The backbone's 1/16 merge, 768 → 128 at 64×28: 56 tiles of 64×64, 224 of 32×32.
+  EXPECT_EQ(gemm_tile_for(128, 64 * 28, 1, gpu), vulkan::kGemmTile32);
+  // The split Winograd's 36 products of a refinement layer (96 channels, 32 × 14 tiles).
+  EXPECT_EQ(gemm_tile_for(96, 32 * 14, 36, gpu), vulkan::kGemmTile128);
+  // On a CPU device a product of one 128×128 tile takes 64×64, and of one 64×64 tile 32×32.
+  EXPECT_EQ(gemm_tile_for(128, 128, 1, cpu), vulkan::kGemmTile64);
+  EXPECT_EQ(gemm_tile_for(64, 64, 1, cpu), vulkan::kGemmTile32);
+  // A tile asked for is taken whatever the grid.
+  EXPECT_EQ(gemm_tile_for(8, 8, 1, {128, vulkan::kGpuWideGrid}), vulkan::kGemmTile128);
+  EXPECT_EQ(gemm_tile_for(4096, 4096, 1, {32, 2}), vulkan::kGemmTile32);
+  EXPECT_EQ(vulkan::kGemmTile128.rows(), 128);
+  EXPECT_EQ(vulkan::kGemmTile32.columns(), 32);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "graph/activation.hpp"
 #include "graph/tensors.hpp"
 #include "neuflow/model/device_work.hpp"
+#include "vulkan/gemm_tile.hpp"
 #include "vulkan/vulkan_network.hpp"
 
 namespace neuflow::model::vulkan {
@@ -129,16 +130,22 @@ class VulkanNetwork::Recorder {
     record_dispatch(S, bindings, &push, sizeof push, work, {gx, gy, gz});
   }
 
-  // A product (conv2d, matmul or winograd_gemm) on the kernels the network runs its products
-  // on (product_kernels.hpp): every variant takes the scalar shader's parameters and grid.
+  // A product (conv2d, matmul or winograd_gemm) of m × n outputs, `batches` times, on the
+  // kernels the network runs its products on (product_kernels.hpp): every variant takes the
+  // scalar shader's parameters; the scalar kernel runs in the tile gemm_tile_for() chooses, the
+  // fragments in 64×64. `what` names the layer in a too-large-for-one-dispatch error.
   template <Shader S>
   void product(std::array<const Buffer*, kShaderBindings> bindings, const typename ShaderParams<S>::type& push,
-               const Work& work, uint32_t gx, uint32_t gy = 1, uint32_t gz = 1) {
-    record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work, {gx, gy, gz});
+               const Work& work, long m, long n, const char* what, uint32_t batches = 1) {
+    const GemmTile tile =
+        net_.products_ == ProductKernels::scalar ? gemm_tile_for(m, n, batches, net_.gemm_tiles_) : kGemmTile64;
+    record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work,
+                    {tiles(n, what, tile.columns()), tiles(m, what, tile.rows()), batches}, tile);
   }
 
+  // `tile`: a scalar product's (matmul.comp's specialization); other shaders have none.
   void record_dispatch(Shader shader, std::array<const Buffer*, kShaderBindings> bindings, const void* push,
-                       std::size_t bytes, const Work& work, std::array<uint32_t, 3> grid) {
+                       std::size_t bytes, const Work& work, std::array<uint32_t, 3> grid, GemmTile tile = kGemmTile64) {
     std::array<VkBuffer, kShaderBindings> handles{};
     std::vector<Span> reads, writes;
     const auto& access = shader_info(shader).bindings;
@@ -149,7 +156,7 @@ class VulkanNetwork::Recorder {
     }
     order(reads, writes);
     VkDescriptorSet set = net_.descriptor_set(handles);
-    vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader, net_.fp16_));
+    vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader, net_.fp16_, tile));
     vkCmdBindDescriptorSets(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline_layout(), 0, 1, &set, 0,
                             nullptr);
     vkCmdPushConstants(commands_, net_.device_.pipeline_layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0,

@@ -1,7 +1,10 @@
 #include "vulkan/vulkan_backend.hpp"
 
+#include <thread>
+
 #include "vulkan/conv_algorithm.hpp"
 #include "vulkan/device_weights.hpp"
+#include "vulkan/gemm_tile.hpp"
 #include "vulkan/product_kernels.hpp"
 #include "vulkan/vulkan_instance.hpp"
 #include "vulkan/vulkan_network.hpp"
@@ -12,6 +15,7 @@ struct VulkanContext {
   std::shared_ptr<const vulkan::DeviceWeights> weights;
   vulkan::ProductKernels products = vulkan::ProductKernels::scalar;
   vulkan::ConvAlgorithm conv = vulkan::ConvAlgorithm::winograd_fused;
+  vulkan::GemmTiles gemm_tiles;
 };
 
 namespace {
@@ -19,7 +23,8 @@ namespace {
 class VulkanBackend final : public InferenceBackend {
  public:
   VulkanBackend(std::shared_ptr<VulkanContext> context, int height, int width)
-      : context_(std::move(context)), network_(context_->weights, height, width, context_->products, context_->conv) {}
+      : context_(std::move(context)),
+        network_(context_->weights, height, width, context_->products, context_->conv, context_->gemm_tiles) {}
   int width() const override { return network_.width(); }
   int height() const override { return network_.height(); }
   void encode(const Tensor& image, int slot) override { network_.encode(image, slot); }
@@ -87,6 +92,7 @@ std::shared_ptr<VulkanContext> open_vulkan(const std::shared_ptr<const FlowModel
     }
   }
   context->conv = vulkan::conv_algorithm_for();
+  context->gemm_tiles = vulkan::gemm_tiles_for(device->info().is_gpu(), std::thread::hardware_concurrency());
   context->weights = vulkan::DeviceWeights::get(model, device, fp16,
                                                 vulkan::winograd_filters_at_upload(context->conv, context->products));
   return context;

@@ -198,9 +198,10 @@ bool VulkanDevice::can_run(Shader shader, bool fp16) const {
   return (fp16 ? info_.fp16 : !s.spirv.empty()) && (!s.tensor_cores || info_.tensor_cores);
 }
 
-VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16) {
+VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16, const GemmTile* tile) {
   const auto code = spirv(shader, fp16);
-  const std::string name = std::string(shader_name(shader)) + (fp16 ? " (fp16)" : "");
+  std::string name = std::string(shader_name(shader)) + (fp16 ? " (fp16)" : "");
+  if (tile) name += ", " + std::to_string(tile->rows()) + "x" + std::to_string(tile->columns()) + " tiles";
   VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   module_info.codeSize = code.size_bytes();
   module_info.pCode = code.data();
@@ -211,6 +212,12 @@ VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16) {
   pipeline.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   pipeline.stage.module = module;
   pipeline.stage.pName = "main";
+  // matmul.comp's constant_id 0 and 1: TM and TN.
+  const std::array<int32_t, 2> tile_values{tile ? tile->tm : 0, tile ? tile->tn : 0};
+  const std::array<VkSpecializationMapEntry, 2> entries{VkSpecializationMapEntry{0, 0, sizeof(int32_t)},
+                                                        VkSpecializationMapEntry{1, sizeof(int32_t), sizeof(int32_t)}};
+  const VkSpecializationInfo specialization{2, entries.data(), sizeof tile_values, tile_values.data()};
+  if (tile) pipeline.stage.pSpecializationInfo = &specialization;
   pipeline.layout = pipeline_layout_;
   VkPipeline created = VK_NULL_HANDLE;
   const VkResult r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline, nullptr, &created);
@@ -235,6 +242,15 @@ VkPipeline VulkanDevice::pipeline(Shader shader, bool fp16) {
   return fp16_pipelines_[s];
 }
 
+VkPipeline VulkanDevice::pipeline(Shader shader, bool fp16, GemmTile tile) {
+  if (tile == kGemmTile64) return pipeline(shader, fp16);
+  if (!can_run(shader, fp16)) return pipeline(shader, fp16);  // throws, saying why
+  const std::lock_guard lock(pipeline_mutex_);
+  VkPipeline& p = tiled_pipelines_[{shader, fp16, tile.tm, tile.tn}];
+  if (p == VK_NULL_HANDLE) p = create_pipeline(shader, fp16, &tile);
+  return p;
+}
+
 VulkanDevice::~VulkanDevice() { destroy(); }
 
 void VulkanDevice::destroy() {
@@ -246,6 +262,10 @@ void VulkanDevice::destroy() {
       p = VK_NULL_HANDLE;
     }
   }
+  for (auto& [key, p] : tiled_pipelines_) {
+    if (p != VK_NULL_HANDLE) vkDestroyPipeline(device_, p, nullptr);
+  }
+  tiled_pipelines_.clear();
   if (pipeline_layout_ != VK_NULL_HANDLE) vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
   if (set_layout_ != VK_NULL_HANDLE) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
   pipeline_layout_ = VK_NULL_HANDLE;

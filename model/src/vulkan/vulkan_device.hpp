@@ -6,11 +6,14 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <tuple>
 #include <utility>
 
+#include "vulkan/gemm_tile.hpp"
 #include "vulkan/shaders.hpp"
 #include "vulkan/vulkan_api.hpp"
 
@@ -63,6 +66,9 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   // The fp16 variants are created on first use. Throws BackendError for a shader the device
   // cannot run (can_run()).
   VkPipeline pipeline(Shader shader, bool fp16);
+  // A scalar product's pipeline (matmul.comp) specialized to `tile`; the 64×64 tile is the
+  // shader's own, the others are created on first use.
+  VkPipeline pipeline(Shader shader, bool fp16, GemmTile tile);
   // Whether the shader exists in that precision and the device has what it needs.
   bool can_run(Shader shader, bool fp16) const;
   VkPipelineLayout pipeline_layout() const { return pipeline_layout_; }
@@ -94,7 +100,7 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   friend class Buffer;
   VulkanDevice(VkPhysicalDevice physical, int index);
   void create_pipelines();
-  VkPipeline create_pipeline(Shader shader, bool fp16);
+  VkPipeline create_pipeline(Shader shader, bool fp16, const GemmTile* tile = nullptr);
   void destroy();
   uint32_t memory_type(uint32_t allowed, Memory memory) const;
   void release(Buffer& buffer);
@@ -112,6 +118,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
   std::array<VkPipeline, kShaderCount> pipelines_{};
   std::array<VkPipeline, kShaderCount> fp16_pipelines_{};
+  // The products' other tiles: (shader, fp16, TM, TN).
+  std::map<std::tuple<Shader, bool, int, int>, VkPipeline> tiled_pipelines_;
   std::mutex pipeline_mutex_;
   std::mutex queue_mutex_;
   std::mutex memory_mutex_;

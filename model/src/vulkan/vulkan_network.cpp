@@ -13,12 +13,13 @@
 namespace neuflow::model::vulkan {
 
 VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width,
-                             ProductKernels products, ConvAlgorithm conv)
+                             ProductKernels products, ConvAlgorithm conv, GemmTiles gemm_tiles)
     : weights_(std::move(weights)),
       device_(*weights_->device),
       fp16_(weights_->fp16),
       products_(products),
       conv_(conv),
+      gemm_tiles_(gemm_tiles),
       elem_(fp16_ ? 2 : 4),
       height_(height),
       width_(width),

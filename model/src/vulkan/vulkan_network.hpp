@@ -32,6 +32,7 @@
 #include "tensor.hpp"
 #include "vulkan/conv_algorithm.hpp"
 #include "vulkan/device_weights.hpp"
+#include "vulkan/gemm_tile.hpp"
 #include "vulkan/product_kernels.hpp"
 
 namespace neuflow::model::vulkan {
@@ -52,9 +53,11 @@ class VulkanNetwork {
 
   // height, width: multiples of 16, at least 32. products: the kernels its products run on
   // (product_kernels_for()); conv: how the Winograd layers run where the weights have
-  // transformed filters (conv_algorithm_for()). Throws BackendError (e.g. out of memory).
+  // transformed filters (conv_algorithm_for()); gemm_tiles: how the scalar products choose
+  // their tiles (gemm_tiles_for()). Throws BackendError (e.g. out of memory).
   VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int height, int width,
-                ProductKernels products = ProductKernels::scalar, ConvAlgorithm conv = ConvAlgorithm::winograd_fused);
+                ProductKernels products = ProductKernels::scalar, ConvAlgorithm conv = ConvAlgorithm::winograd_fused,
+                GemmTiles gemm_tiles = {});
   ~VulkanNetwork();
   VulkanNetwork(const VulkanNetwork&) = delete;
   VulkanNetwork& operator=(const VulkanNetwork&) = delete;
@@ -155,7 +158,8 @@ class VulkanNetwork {
   bool fp16_;  // tensors stored as float16_t
   ProductKernels products_;
   ConvAlgorithm conv_;  // split Winograd goes through the two buffers below
-  std::size_t elem_;    // bytes per stored value: 4 or 2
+  GemmTiles gemm_tiles_;
+  std::size_t elem_;  // bytes per stored value: 4 or 2
   int height_, width_, tokens_, block_rows_;
 
   Buffer dummy_, zeros_;

@@ -74,8 +74,7 @@ void record_winograd(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const V
       {&r.device_weights().winograd_buffer, &r.winograd_points(), &r.winograd_products(), nullptr},
       WinogradGemmParams{out.c, tile_count, in.c, r.device_weights().winograd_filters_of(w), winograd_filter_side(in.c),
                          winograd_filter_side(out.c)},
-      {r.bytes(filters) + fp32(points), fp32(products), filters * tile_count}, tiles(tile_count, "a convolution"),
-      tiles(out.c, "a convolution"), 36);
+      {r.bytes(filters) + fp32(points), fp32(products), filters * tile_count}, out.c, tile_count, "a convolution", 36);
   const WinogradOutputParams p{out.c,
                                out.h,
                                out.w,
@@ -130,8 +129,8 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
                        op.addend ? addend.offset() : -1,
                        1.f};
   r.product<Shader::conv2d>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
-                            {r.bytes(read), r.bytes(out.count()), taps * out.count()},
-                            tiles(static_cast<long>(out.h) * out.w, "a convolution"), tiles(out.c, "a convolution"));
+                            {r.bytes(read), r.bytes(out.count()), taps * out.count()}, out.c,
+                            static_cast<long>(out.h) * out.w, "a convolution");
 }
 
 }  // namespace neuflow::model::vulkan

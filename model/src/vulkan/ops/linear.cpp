@@ -25,8 +25,8 @@ void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op) {
   const long long weights = static_cast<long long>(w.out_features) * w.in_features;
   const long long read = weights + (w.bias.offset >= 0 ? w.out_features : 0) + in.count();
   r.product<Shader::matmul>({&r.weights(), in.buffer, out.buffer, nullptr}, p,
-                            {r.bytes(read), r.bytes(out.count()), weights * tokens}, tiles(tokens, "attention"),
-                            tiles(w.out_features, "attention"));
+                            {r.bytes(read), r.bytes(out.count()), weights * tokens}, w.out_features, tokens,
+                            "attention");
 }
 
 }  // namespace neuflow::model::vulkan
