@@ -33,7 +33,7 @@ struct GemmTiles {
 // A GPU: two workgroups for each of the 132 compute units of an H100 would be 264; 128 keeps a
 // GPU of half that size (an RTX 4070's 46 SMs, a Radeon's 60 CUs) at two or more, and a Jetson
 // Orin (8 or 16 SMs) takes the largest tile that many workgroups allow. A CPU device (lavapipe)
-// runs a workgroup per core: there 128×128 tiles take 0.86× the time of 64×64 ones a frame at
+// runs a workgroup per core: there 128×128 tiles take 0.85× the time of 64×64 ones a frame at
 // 160×128 with every convolution direct, and 32×32 ones 1.6× (docs/benchmarks.md).
 inline constexpr long kGpuWideGrid = 128;
 
