@@ -126,28 +126,12 @@ TEST_F(VulkanSession, EveryStageEqualsTheCpuAtAnOddSizeAndOtherIterations) {
 // The stride-1 3×3 convolutions by the fused Winograd kernel (the default, which every other
 // test here runs), by Winograd in three dispatches (NEUFLOW_VULKAN_CONV=winograd-split, what the
 // tensor-core products take) and by the direct implicit GEMM (NEUFLOW_VULKAN_CONV=direct, the
-// way back) give the CPU's flow; a bad value is an error naming the variable.
+// way back) give the CPU's flow. Both run through the scalar products (matmul.comp: with every
+// convolution direct, all of them but the attention's; split, the 36 batched Winograd products
+// too), here in each tile they take (NEUFLOW_VULKAN_GEMM_TILE; auto, the default every other test
+// runs, takes them by the grid): every output's products are summed in the same order at every
+// size, so the flows agree to the bit. A bad value of either variable is an error naming it.
 TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
-  FlowSession cpu(model_, {.threads = 2, .backend = Backend::cpu});
-  const auto expected = cpu.compute(view_of(frames_[0]), view_of(frames_[1]));
-  for (const char* conv : {"direct", "winograd-split"}) {
-    ASSERT_EQ(setenv("NEUFLOW_VULKAN_CONV", conv, 1), 0);
-    FlowSession gpu(model_, {.backend = Backend::vulkan});
-    const Errors e = compare(gpu.compute(view_of(frames_[0]), view_of(frames_[1])), expected);
-    EXPECT_LT(e.max, 1e-2) << conv;
-    EXPECT_LT(e.mean, 1e-3) << conv;
-  }
-  unsetenv("NEUFLOW_VULKAN_CONV");
-  expect_refused("NEUFLOW_VULKAN_CONV", "fast");
-}
-
-// The scalar products (matmul.comp) in each of their tiles: 32×32, 64×64 and 128×128 outputs a
-// workgroup (NEUFLOW_VULKAN_GEMM_TILE; auto, the default every other test runs, takes them by
-// the grid). With every convolution direct, all of them but the Winograd layers' go through it,
-// and the split Winograd's 36 batched products with the largest tile. Each output's products
-// are summed in the same order at every tile size, so the flows agree to the bit, and with the
-// CPU's; a bad value is an error naming the variable.
-TEST_F(VulkanSession, EveryProductTileGivesTheSameFlowToTheBit) {
   FlowSession cpu(model_, {.threads = 2, .backend = Backend::cpu});
   const auto expected = cpu.compute(view_of(frames_[0]), view_of(frames_[1]));
   const auto flow_with = [&](const char* conv, const char* tile) {
@@ -157,6 +141,9 @@ TEST_F(VulkanSession, EveryProductTileGivesTheSameFlowToTheBit) {
     auto flow = gpu.compute(view_of(frames_[0]), view_of(frames_[1]));
     unsetenv("NEUFLOW_VULKAN_CONV");
     unsetenv("NEUFLOW_VULKAN_GEMM_TILE");
+    const Errors e = compare(flow, expected);
+    EXPECT_LT(e.max, 1e-2) << conv << ", " << tile << " tiles";
+    EXPECT_LT(e.mean, 1e-3) << conv << ", " << tile << " tiles";
     return flow;
   };
   // How many of the flows' values differ, bit for bit.
@@ -168,14 +155,10 @@ TEST_F(VulkanSession, EveryProductTileGivesTheSameFlowToTheBit) {
     }
     return n;
   };
-  const auto direct64 = flow_with("direct", "64");
-  const Errors e = compare(direct64, expected);
-  EXPECT_LT(e.max, 1e-2);
-  EXPECT_LT(e.mean, 1e-3);
-  for (const char* tile : {"32", "128"}) {
-    EXPECT_EQ(differing(flow_with("direct", tile), direct64), 0U) << tile << "×" << tile << " against 64×64 tiles";
-  }
-  EXPECT_EQ(differing(flow_with("winograd-split", "128"), flow_with("winograd-split", "64")), 0U);
+  EXPECT_EQ(differing(flow_with("direct", "32"), flow_with("direct", "128")), 0U) << "32×32 against 128×128 tiles";
+  EXPECT_EQ(differing(flow_with("winograd-split", "64"), flow_with("winograd-split", "128")), 0U)
+      << "64×64 against 128×128 tiles";
+  expect_refused("NEUFLOW_VULKAN_CONV", "fast");
   expect_refused("NEUFLOW_VULKAN_GEMM_TILE", "96");
 }
 
