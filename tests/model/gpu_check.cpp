@@ -8,7 +8,8 @@
 //  - fp16 with the scalar products against fp32, within the fp16 bound;
 //  - where the GPU has tensor cores: their flow against their emulated twin's and against fp32,
 //    within the same bound.
-// Then one table: per size, precision and product kernels, a streamed frame's time (pipelined,
+// Then one table: per size, precision and product kernels (and the scalar products in 64×64
+// tiles, against their tiles chosen by the grid), a streamed frame's time (pipelined,
 // frames in flight), a pair's, the GPU's own time of a frame (its timestamps), and what a frame
 // asks of it (dispatches, barriers, GB moved, GMAC).
 #include <stdlib.h>  // mkdtemp, setenv
@@ -60,11 +61,18 @@ ImageView view(const std::vector<std::uint8_t>& bgr, const Size& s) {
   return ImageView{bgr.data(), s.w, s.h, static_cast<std::ptrdiff_t>(s.w) * 3, ChannelOrder::bgr};
 }
 
-// NEUFLOW_VULKAN_PRODUCTS for the sessions made while it lives.
+// NEUFLOW_VULKAN_PRODUCTS (and the scalar products' NEUFLOW_VULKAN_GEMM_TILE) for the sessions
+// made while it lives.
 class Products {
  public:
-  explicit Products(const char* kernels) { setenv("NEUFLOW_VULKAN_PRODUCTS", kernels, 1); }
-  ~Products() { unsetenv("NEUFLOW_VULKAN_PRODUCTS"); }
+  explicit Products(const char* kernels, const char* tile = "auto") {
+    setenv("NEUFLOW_VULKAN_PRODUCTS", kernels, 1);
+    setenv("NEUFLOW_VULKAN_GEMM_TILE", tile, 1);
+  }
+  ~Products() {
+    unsetenv("NEUFLOW_VULKAN_PRODUCTS");
+    unsetenv("NEUFLOW_VULKAN_GEMM_TILE");
+  }
   Products(const Products&) = delete;
   Products& operator=(const Products&) = delete;
 };
@@ -126,9 +134,10 @@ double milliseconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// `tile`: the scalar products' (NEUFLOW_VULKAN_GEMM_TILE); "auto" chooses by the grid.
 void time_row(const std::shared_ptr<const FlowModel>& model, int device, const Size& s, Precision precision,
-              const char* products, int frames, int pair_count) {
-  const Products chosen(products);
+              const char* products, int frames, int pair_count, const char* tile = "auto") {
+  const Products chosen(products, tile);
   FlowSession session(model, options(device, precision));
   std::vector<std::vector<std::uint8_t>> drawn(4);
   for (int i = 0; i < 4; ++i) drawn[static_cast<std::size_t>(i)] = draw_frame(s, i);
@@ -159,8 +168,9 @@ void time_row(const std::shared_ptr<const FlowModel>& model, int device, const S
   }
   std::sort(pairs.begin(), pairs.end());
   std::printf("| %4dx%-4d | %-4s | %-12s | %8.2f | %8.2f | %8.2f | %2d | %5d | %5d | %6.3f | %7.2f |\n", s.w, s.h,
-              precision == Precision::fp16 ? "fp16" : "fp32", products, stream_ms, pairs[pairs.size() / 2], device_ms,
-              depth, work.dispatches, work.barriers,
+              precision == Precision::fp16 ? "fp16" : "fp32",
+              (std::string(products) + (std::string(tile) == "auto" ? "" : std::string(", ") + tile)).c_str(),
+              stream_ms, pairs[pairs.size() / 2], device_ms, depth, work.dispatches, work.barriers,
               static_cast<double>(work.bytes_read() + work.bytes_written()) / 1e9,
               static_cast<double>(work.multiply_adds()) / 1e9);
 }
@@ -244,6 +254,9 @@ int run(int argc, char** argv) {
       return 2;
     }
     time_row(model, device, *s, Precision::fp32, "scalar", frames, pairs);
+    // The scalar products in the 64×64 tiles they all took before the tiles were chosen by
+    // the grid (docs/benchmarks.md): what the choice is worth on this GPU.
+    time_row(model, device, *s, Precision::fp32, "scalar", frames, pairs, "64");
     if (!gpu.fp16) continue;
     time_row(model, device, *s, Precision::fp16, "scalar", frames, pairs);
     if (gpu.tensor_cores) time_row(model, device, *s, Precision::fp16, "tensor-cores", frames, pairs);
