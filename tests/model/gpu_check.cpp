@@ -8,8 +8,8 @@
 //  - fp16 with the scalar products against fp32, within the fp16 bound;
 //  - where the GPU has tensor cores: their flow against their emulated twin's and against fp32,
 //    within the same bound.
-// Then one table: per size, precision and product kernels (and the scalar products in 64×64
-// tiles, against their tiles chosen by the grid), a streamed frame's time (pipelined,
+// Then one table: per size, precision and product kernels (and the products in 64×64 tiles,
+// against their tiles chosen by the grid), a streamed frame's time (pipelined,
 // frames in flight), a pair's, the GPU's own time of a frame (its timestamps), and what a frame
 // asks of it (dispatches, barriers, GB moved, GMAC).
 #include <stdlib.h>  // mkdtemp, setenv
@@ -254,12 +254,15 @@ int run(int argc, char** argv) {
       return 2;
     }
     time_row(model, device, *s, Precision::fp32, "scalar", frames, pairs);
-    // The scalar products in the 64×64 tiles they all took before the tiles were chosen by
-    // the grid (docs/benchmarks.md): what the choice is worth on this GPU.
+    // The products in the 64×64 tiles they all took before the tiles were chosen by the grid
+    // (docs/benchmarks.md): what the choice is worth on this GPU.
     time_row(model, device, *s, Precision::fp32, "scalar", frames, pairs, "64");
     if (!gpu.fp16) continue;
     time_row(model, device, *s, Precision::fp16, "scalar", frames, pairs);
-    if (gpu.tensor_cores) time_row(model, device, *s, Precision::fp16, "tensor-cores", frames, pairs);
+    if (gpu.tensor_cores) {
+      time_row(model, device, *s, Precision::fp16, "tensor-cores", frames, pairs);
+      time_row(model, device, *s, Precision::fp16, "tensor-cores", frames, pairs, "64");
+    }
   }
   std::printf("\n%s: %d check(s) failed\n", failures == 0 ? "passed" : "FAILED", failures);
   return failures == 0 ? 0 : 1;

@@ -9,10 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <bit>
 #include <chrono>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -23,6 +21,7 @@
 #include "neuflow/model/gpu_devices.hpp"
 #include "support/camera_frames.hpp"
 #include "support/fixtures.hpp"
+#include "support/flow_difference.hpp"
 #include "support/flow_error.hpp"
 #include "support/vulkan.hpp"
 
@@ -146,17 +145,9 @@ TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
     EXPECT_LT(e.mean, 1e-3) << conv << ", " << tile << " tiles";
     return flow;
   };
-  // How many of the flows' values differ, bit for bit.
-  const auto differing = [](const flow::FlowField& a, const flow::FlowField& b) {
-    EXPECT_EQ(a.uv.size(), b.uv.size());
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < std::min(a.uv.size(), b.uv.size()); ++i) {
-      n += std::bit_cast<std::uint32_t>(a.uv[i]) != std::bit_cast<std::uint32_t>(b.uv[i]) ? 1 : 0;
-    }
-    return n;
-  };
-  EXPECT_EQ(differing(flow_with("direct", "32"), flow_with("direct", "128")), 0U) << "32×32 against 128×128 tiles";
-  EXPECT_EQ(differing(flow_with("winograd-split", "64"), flow_with("winograd-split", "128")), 0U)
+  EXPECT_EQ(test::differing_values(flow_with("direct", "32"), flow_with("direct", "128")), 0U)
+      << "32×32 against 128×128 tiles";
+  EXPECT_EQ(test::differing_values(flow_with("winograd-split", "64"), flow_with("winograd-split", "128")), 0U)
       << "64×64 against 128×128 tiles";
   expect_refused("NEUFLOW_VULKAN_CONV", "fast");
   expect_refused("NEUFLOW_VULKAN_GEMM_TILE", "96");

@@ -19,20 +19,21 @@
 #include "neuflow/model/gpu_devices.hpp"
 #include "support/camera_frames.hpp"
 #include "support/fixtures.hpp"
+#include "support/flow_difference.hpp"
 #include "support/flow_error.hpp"
 #include "support/vulkan.hpp"
 
 namespace neuflow::model {
 namespace {
 
-// Sets NEUFLOW_VULKAN_PRODUCTS (and NEUFLOW_VULKAN_CONV) for the sessions made in its scope,
-// and the scalar products' tiles to the fragments' 64×64, so that both run the same grids.
+// Sets NEUFLOW_VULKAN_PRODUCTS (and NEUFLOW_VULKAN_CONV, NEUFLOW_VULKAN_GEMM_TILE) for the
+// sessions made in its scope.
 class ProductKernelsScope {
  public:
-  explicit ProductKernelsScope(const char* products, const char* conv = "winograd") {
+  explicit ProductKernelsScope(const char* products, const char* conv = "winograd", const char* tile = "auto") {
     setenv("NEUFLOW_VULKAN_PRODUCTS", products, 1);
     setenv("NEUFLOW_VULKAN_CONV", conv, 1);
-    setenv("NEUFLOW_VULKAN_GEMM_TILE", "64", 1);
+    setenv("NEUFLOW_VULKAN_GEMM_TILE", tile, 1);
   }
   ~ProductKernelsScope() {
     unsetenv("NEUFLOW_VULKAN_PRODUCTS");
@@ -147,6 +148,24 @@ TEST_F(VulkanTensorCores, TheTwinStaysWithinTheFp16BoundOfFp32) {
     RecordProperty("twin_mean_epe_" + std::to_string(w) + "x" + std::to_string(h) + "_" + conv, std::to_string(e.epe));
     test::expect_within_fp16_bound(e, where.c_str());
   }
+}
+
+// The twin in each of its tiles (NEUFLOW_VULKAN_GEMM_TILE): 32×32 (4 subgroups of one fragment),
+// 64×64 (4 of 2×2) and 128×128 (8 of 2×4), with every convolution direct and with the split
+// Winograd's 36 batched products. Each output's fragment products are summed in K order at
+// every size, so the flows agree to the bit; auto, which the other tests run, takes them by
+// the grid, and holds the twin within the fp16 bound above.
+TEST_F(VulkanTensorCores, TheTwinsTilesAgreeToTheBit) {
+  const auto flow_with = [&](int w, int h, const char* conv, const char* tile) {
+    const auto f = frames(w, h);
+    const ProductKernelsScope scope("twin", conv, tile);
+    FlowSession twin(model_, options(Precision::fp16));
+    return twin.compute(test::bgr_view(f[0]), test::bgr_view(f[1]));
+  };
+  EXPECT_EQ(test::differing_values(flow_with(100, 60, "direct", "32"), flow_with(100, 60, "direct", "128")), 0U);
+  EXPECT_EQ(
+      test::differing_values(flow_with(160, 128, "winograd-split", "128"), flow_with(160, 128, "winograd-split", "64")),
+      0U);
 }
 
 // What NEUFLOW_VULKAN_PRODUCTS cannot do is an error saying why: tensor cores on a device

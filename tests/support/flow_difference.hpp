@@ -2,8 +2,10 @@
 // How far one flow field is from a reference, pixel by pixel: what the tests' fp16 bound and
 // neuflow-gpu-check's checks are stated in. No test framework, so the GPU check can use it.
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 
 #include "neuflow/flow/flow_field.hpp"
 
@@ -35,6 +37,17 @@ inline FlowDifference flow_difference(const flow::FlowField& reference, const fl
   d.epe /= count;
   d.magnitude /= count;
   return d;
+}
+
+// How many of the two fields' values differ bit for bit (their sizes' difference counted too):
+// 0 where two ways of computing promise the same sums in the same order.
+inline std::size_t differing_values(const flow::FlowField& a, const flow::FlowField& b) {
+  const std::size_t n = std::min(a.uv.size(), b.uv.size());
+  std::size_t differing = std::max(a.uv.size(), b.uv.size()) - n;
+  for (std::size_t i = 0; i < n; ++i) {
+    differing += std::bit_cast<std::uint32_t>(a.uv[i]) != std::bit_cast<std::uint32_t>(b.uv[i]) ? 1 : 0;
+  }
+  return differing;
 }
 
 }  // namespace neuflow::test

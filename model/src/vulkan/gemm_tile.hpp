@@ -1,13 +1,14 @@
 #pragma once
-// The tile a scalar product (matmul.comp: the implicit-GEMM convolutions, the split Winograd
-// products, the matrix products) runs in: 16×16 invocations of TM×TN outputs, fixed by
-// specialization constants so that each size is its own pipeline with its loops unrolled.
+// The tile a product (the implicit-GEMM convolutions, the split Winograd products, the matrix
+// products) runs in: on the scalar kernel (matmul.comp) 16×16 invocations of TM×TN outputs; on
+// tensor cores or their twin (matmul_fragments.comp) subgroups of 16×16 fragments. Fixed by
+// specialization constants, so that each size is its own pipeline with its loops unrolled.
 // Larger tiles read each operand fewer times (an invocation's 8×8 outputs take 16 loads from
 // workgroup memory for 64 multiply-adds, 4×4 take 8 for 16), but a grid of few tiles leaves most
 // of a large GPU's compute units without work: a layer takes the largest tile whose grid still
-// has the device's wide grid of workgroups, else the smallest. The tensor-core products keep
-// their 64×64 tiles. NEUFLOW_VULKAN_GEMM_TILE=auto|32|64|128 chooses (auto, the default: by the
-// grid as above; a number: that tile for every scalar product, to compare).
+// has the device's wide grid of workgroups, else the smallest. NEUFLOW_VULKAN_GEMM_TILE=
+// auto|32|64|128 chooses (auto, the default: by the grid as above; a number: that tile for every
+// product, to compare).
 #include <algorithm>
 #include <cstdlib>
 #include <stdexcept>
@@ -19,6 +20,9 @@ struct GemmTile {
   int tm = 4, tn = 4;  // outputs per invocation along M (rows of C) and N (its columns)
   int rows() const { return 16 * tm; }
   int columns() const { return 16 * tn; }
+  // matmul_fragments.comp's workgroup: subgroups of 32, 2 across the tile's columns and 4 down
+  // its rows for 128×128 (2×4 fragments each), else 2 (2×2 fragments each at 64×64, one at 32×32).
+  int fragment_invocations() const { return rows() >= 128 ? 256 : 128; }
   bool operator==(const GemmTile&) const = default;
 };
 

@@ -132,18 +132,17 @@ class VulkanNetwork::Recorder {
 
   // A product (conv2d, matmul or winograd_gemm) of m × n outputs, `batches` times, on the
   // kernels the network runs its products on (product_kernels.hpp): every variant takes the
-  // scalar shader's parameters; the scalar kernel runs in the tile gemm_tile_for() chooses, the
-  // fragments in 64×64. `what` names the layer in a too-large-for-one-dispatch error.
+  // scalar shader's parameters, in the tile gemm_tile_for() chooses. `what` names the layer in
+  // a too-large-for-one-dispatch error.
   template <Shader S>
   void product(std::array<const Buffer*, kShaderBindings> bindings, const typename ShaderParams<S>::type& push,
                const Work& work, long m, long n, const char* what, uint32_t batches = 1) {
-    const GemmTile tile =
-        net_.products_ == ProductKernels::scalar ? gemm_tile_for(m, n, batches, net_.gemm_tiles_) : kGemmTile64;
+    const GemmTile tile = gemm_tile_for(m, n, batches, net_.gemm_tiles_);
     record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work,
                     {tiles(n, what, tile.columns()), tiles(m, what, tile.rows()), batches}, tile);
   }
 
-  // `tile`: a scalar product's (matmul.comp's specialization); other shaders have none.
+  // `tile`: a product's (its kernel's specialization); other shaders have none.
   void record_dispatch(Shader shader, std::array<const Buffer*, kShaderBindings> bindings, const void* push,
                        std::size_t bytes, const Work& work, std::array<uint32_t, 3> grid, GemmTile tile = kGemmTile64) {
     std::array<VkBuffer, kShaderBindings> handles{};

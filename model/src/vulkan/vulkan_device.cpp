@@ -212,11 +212,14 @@ VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16, const GemmTil
   pipeline.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   pipeline.stage.module = module;
   pipeline.stage.pName = "main";
-  // matmul.comp's constant_id 0 and 1: TM and TN.
-  const std::array<int32_t, 2> tile_values{tile ? tile->tm : 0, tile ? tile->tn : 0};
-  const std::array<VkSpecializationMapEntry, 2> entries{VkSpecializationMapEntry{0, 0, sizeof(int32_t)},
-                                                        VkSpecializationMapEntry{1, sizeof(int32_t), sizeof(int32_t)}};
-  const VkSpecializationInfo specialization{2, entries.data(), sizeof tile_values, tile_values.data()};
+  // The products' constant_id 0 and 1 (TM and TN), and 2, the fragments' workgroup size (which
+  // matmul.comp does not have, and so ignores).
+  const std::array<int32_t, 3> tile_values{tile ? tile->tm : 0, tile ? tile->tn : 0,
+                                           tile ? tile->fragment_invocations() : 0};
+  std::array<VkSpecializationMapEntry, 3> entries{};
+  for (uint32_t i = 0; i < entries.size(); ++i) entries[i] = {i, i * uint32_t{sizeof(int32_t)}, sizeof(int32_t)};
+  const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(), sizeof tile_values,
+                                            tile_values.data()};
   if (tile) pipeline.stage.pSpecializationInfo = &specialization;
   pipeline.layout = pipeline_layout_;
   VkPipeline created = VK_NULL_HANDLE;

@@ -66,8 +66,8 @@ class VulkanDevice : public std::enable_shared_from_this<VulkanDevice> {
   // The fp16 variants are created on first use. Throws BackendError for a shader the device
   // cannot run (can_run()).
   VkPipeline pipeline(Shader shader, bool fp16);
-  // A scalar product's pipeline (matmul.comp) specialized to `tile`; the 64×64 tile is the
-  // shader's own, the others are created on first use.
+  // A product's pipeline (matmul.comp, matmul_fragments.comp) specialized to `tile`; the 64×64
+  // tile is the shaders' own, the others are created on first use.
   VkPipeline pipeline(Shader shader, bool fp16, GemmTile tile);
   // Whether the shader exists in that precision and the device has what it needs.
   bool can_run(Shader shader, bool fp16) const;

@@ -1,9 +1,13 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// The products of gemm_operands.glsl on tensor cores: fp16 operands, fp32 sums. Each
-// workgroup of 4 subgroups of 32 computes a 64×64 tile of C; each subgroup a 32×32 quarter of
-// it as 2×2 fragments of 16×16, over K in steps of 32 (two fragment steps of 16) staged as
-// fp16 through workgroup memory.
+// The products of gemm_operands.glsl on tensor cores: fp16 operands, fp32 sums. A workgroup
+// computes a BM×BN tile of C in subgroups of 32, each subgroup FM×FN fragments of 16×16, over K
+// in steps of 32 (two fragment steps of 16) staged as fp16 through workgroup memory. The tile
+// comes from specialization constants as the scalar kernel's does (gemm_tile.hpp):
+//  - 64×64: 4 subgroups (2×2), each 2×2 fragments (the shader's own, without specialization);
+//  - 128×128: 8 subgroups (4×2), each 2×4 fragments, 256 invocations;
+//  - 32×32: 4 subgroups (2×2), each one fragment.
+// Each output's fragment products are summed in K order at every size.
 //  - TENSOR_CORES: the fragments are VK_NV_cooperative_matrix matrices (16×16×16,
 //    fp16 × fp16 + fp32), taken where the device has them (GpuDevice::tensor_cores).
 //  - otherwise the emulated twin, which any fp16 device (lavapipe included) runs: the same
@@ -18,7 +22,11 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #endif
 #include "precision.glsl"
-layout(local_size_x = 128) in;
+// 32 × the subgroups: 128 (the default), or 256 for 128×128.
+layout(local_size_x = 128, local_size_x_id = 2) in;
+layout(constant_id = 0) const int TM = 4;  // the tile: BM = 16·TM rows of C
+layout(constant_id = 1) const int TN = 4;  // and BN = 16·TN columns
+const int INVOCATIONS = int(gl_WorkGroupSize.x);
 
 layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
 #ifdef WINOGRAD_GEMM
@@ -40,14 +48,17 @@ layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the ad
 
 #include "gemm_operands.glsl"
 
-const int BM = 64, BN = 64, BK = 32;  // the workgroup's tile and K step
-const int F = 16;                     // a fragment: 16×16, K 16
+const int BM = 16 * TM, BN = 16 * TN, BK = 32;  // the workgroup's tile and K step
+const int F = 16;                               // a fragment: 16×16, K 16
+const int WARPS = INVOCATIONS / 32, WARPS_N = 2, WARPS_M = WARPS / WARPS_N;
+const int FM = BM / (F * WARPS_M), FN = BN / (F * WARPS_N);  // a subgroup's fragments
+const int MAX_FM = 2, MAX_FN = 4;  // the largest tile's, which size the accumulator arrays
 // Row strides in workgroup memory, padded by 16 bytes: a fragment load's rows start on 16-byte
 // boundaries (as cooperative-matrix loads need) in different banks.
 const int SA = BK + 8, SB = BN + 8, SC = F + 4;
 shared float16_t tile_a[BM * SA];  // [m][k]
 shared float16_t tile_b[BK * SB];  // [k][n]
-shared float sums[4 * F * SC];     // one fragment's sums per subgroup, on their way out
+shared float sums[WARPS * F * SC];  // one fragment's sums per subgroup, on their way out
 
 #ifdef TENSOR_CORES
 #define OPERAND fcoopmatNV<16, gl_ScopeSubgroup, F, F>
@@ -60,10 +71,11 @@ void main() {
   const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
   const int col0 = int(gl_WorkGroupID.x) * BN;  // columns of C (output pixels)
   const int K = gemm_k();
-  // B is gathered by column, each invocation the same column through the K loop, at 16
+  // B is gathered by column, each invocation the same column through the K loop, at B_RUN
   // consecutive k of each step, followed by a cursor (no gathered element divides).
+  const int A_LOADS = BM * BK / INVOCATIONS, B_RUN = BK * BN / INVOCATIONS;
   const GemmColumn column = gemm_column(col0 + tid % BN);
-  const int b_row = 16 * (tid / BN);
+  const int b_row = B_RUN * (tid / BN);
   GemmCursor b_at = gemm_cursor(b_row);
   const GemmCursor one = gemm_cursor(1), step = gemm_cursor(BK);
 #ifdef TENSOR_CORES
@@ -71,30 +83,30 @@ void main() {
 #else
   const int warp = tid / 32;
 #endif
-  const int warp_row = (warp / 2) * 32, warp_col = (warp % 2) * 32;  // its quarter of the tile
+  const int warp_row = (warp / WARPS_N) * F * FM, warp_col = (warp % WARPS_N) * F * FN;  // its part of the tile
 
 #ifdef TENSOR_CORES
-  SUMS acc[2][2];
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) acc[i][j] = SUMS(0.0);
+  SUMS acc[MAX_FM][MAX_FN];
+  for (int i = 0; i < FM; ++i)
+    for (int j = 0; j < FN; ++j) acc[i][j] = SUMS(0.0);
 #else
   // Invocation `lane` holds rows lane / 16 + 2q, column lane % 16 of each fragment.
-  float acc[2][2][8];
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j)
+  float acc[MAX_FM][MAX_FN][8];
+  for (int i = 0; i < FM; ++i)
+    for (int j = 0; j < FN; ++j)
       for (int q = 0; q < 8; ++q) acc[i][j][q] = 0.0;
 #endif
 
   for (int k0 = 0; k0 < K; k0 += BK) {
-    // A: 64 rows × 32 k, adjacent invocations read adjacent k (row-major weights).
-    for (int r = 0; r < 16; ++r) {
-      const int e = tid + 128 * r;
+    // A: BM rows × 32 k, adjacent invocations read adjacent k (row-major weights).
+    for (int r = 0; r < A_LOADS; ++r) {
+      const int e = tid + INVOCATIONS * r;
       const int kk = e % BK, mm = e / BK;
       tile_a[mm * SA + kk] = float16_t(gemm_a(row0 + mm, k0 + kk));
     }
-    // B: 32 k × 64 columns, adjacent invocations read adjacent columns.
+    // B: 32 k × BN columns, adjacent invocations read adjacent columns.
     GemmCursor c = b_at;
-    for (int r = 0; r < 16; ++r) {
+    for (int r = 0; r < B_RUN; ++r) {
       tile_b[(b_row + r) * SB + tid % BN] = float16_t(gemm_b(column, c));
       gemm_advance(c, one);
     }
@@ -102,14 +114,14 @@ void main() {
     barrier();
     for (int kf = 0; kf < BK; kf += F) {
 #ifdef TENSOR_CORES
-      OPERAND a[2], b[2];
-      for (int i = 0; i < 2; ++i) coopMatLoadNV(a[i], tile_a, (warp_row + F * i) * SA + kf, SA, false);
-      for (int j = 0; j < 2; ++j) coopMatLoadNV(b[j], tile_b, kf * SB + warp_col + F * j, SB, false);
-      for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j) acc[i][j] = coopMatMulAddNV(a[i], b[j], acc[i][j]);
+      OPERAND a[MAX_FM], b[MAX_FN];
+      for (int i = 0; i < FM; ++i) coopMatLoadNV(a[i], tile_a, (warp_row + F * i) * SA + kf, SA, false);
+      for (int j = 0; j < FN; ++j) coopMatLoadNV(b[j], tile_b, kf * SB + warp_col + F * j, SB, false);
+      for (int i = 0; i < FM; ++i)
+        for (int j = 0; j < FN; ++j) acc[i][j] = coopMatMulAddNV(a[i], b[j], acc[i][j]);
 #else
-      for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < FM; ++i)
+        for (int j = 0; j < FN; ++j)
           for (int q = 0; q < 8; ++q) {
             const int a_row = (warp_row + F * i + lane / 16 + 2 * q) * SA + kf;
             const int b_col = kf * SB + warp_col + F * j + lane % 16;
@@ -124,9 +136,9 @@ void main() {
 
   // The sums leave a fragment at a time through workgroup memory, so that the epilogue knows
   // where each is (a cooperative matrix's layout across invocations is the driver's).
-  const int out_row = ((tid / 32) / 2) * 32, out_col = ((tid / 32) % 2) * 32;
-  for (int i = 0; i < 2; ++i)
-    for (int j = 0; j < 2; ++j) {
+  const int out_row = ((tid / 32) / WARPS_N) * F * FM, out_col = ((tid / 32) % WARPS_N) * F * FN;
+  for (int i = 0; i < FM; ++i)
+    for (int j = 0; j < FN; ++j) {
 #ifdef TENSOR_CORES
       coopMatStoreNV(acc[i][j], sums, warp * F * SC, SC, false);
 #else
