@@ -212,11 +212,11 @@ VkPipeline VulkanDevice::create_pipeline(Shader shader, bool fp16, const GemmTil
   pipeline.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   pipeline.stage.module = module;
   pipeline.stage.pName = "main";
-  // The products' constant_id 0 and 1 (TM and TN), and 2, the fragments' workgroup size (which
-  // matmul.comp does not have, and so ignores).
-  const std::array<int32_t, 3> tile_values{tile ? tile->tm : 0, tile ? tile->tn : 0,
-                                           tile ? tile->fragment_invocations() : 0};
-  std::array<VkSpecializationMapEntry, 3> entries{};
+  // The products' constant_id 0 and 1 (TM and TN), and the fragments' workgroup size as the
+  // code reads it (2) and as the workgroup has it (3); matmul.comp has neither, and ignores them.
+  const int32_t invocations = tile ? tile->fragment_invocations() : 0;
+  const std::array<int32_t, 4> tile_values{tile ? tile->tm : 0, tile ? tile->tn : 0, invocations, invocations};
+  std::array<VkSpecializationMapEntry, 4> entries{};
   for (uint32_t i = 0; i < entries.size(); ++i) entries[i] = {i, i * uint32_t{sizeof(int32_t)}, sizeof(int32_t)};
   const VkSpecializationInfo specialization{static_cast<uint32_t>(entries.size()), entries.data(), sizeof tile_values,
                                             tile_values.data()};

@@ -22,11 +22,13 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #endif
 #include "precision.glsl"
-// 32 × the subgroups: 128 (the default), or 256 for 128×128.
-layout(local_size_x = 128, local_size_x_id = 2) in;
+// 32 × the subgroups: 128 (the default), or 256 for 128×128. The workgroup size and the
+// constant the code reads are two specialization constants set alike: a driver may read
+// gl_WorkGroupSize at run time (lavapipe does, and then nothing sized by it unrolls).
+layout(local_size_x = 128, local_size_x_id = 3) in;
 layout(constant_id = 0) const int TM = 4;  // the tile: BM = 16·TM rows of C
 layout(constant_id = 1) const int TN = 4;  // and BN = 16·TN columns
-const int INVOCATIONS = int(gl_WorkGroupSize.x);
+layout(constant_id = 2) const int INVOCATIONS = 128;
 
 layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
 #ifdef WINOGRAD_GEMM
@@ -51,8 +53,9 @@ layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the ad
 const int BM = 16 * TM, BN = 16 * TN, BK = 32;  // the workgroup's tile and K step
 const int F = 16;                               // a fragment: 16×16, K 16
 const int WARPS = INVOCATIONS / 32, WARPS_N = 2, WARPS_M = WARPS / WARPS_N;
-const int FM = BM / (F * WARPS_M), FN = BN / (F * WARPS_N);  // a subgroup's fragments
-const int MAX_FM = 2, MAX_FN = 4;  // the largest tile's, which size the accumulator arrays
+// A subgroup's fragments. The arrays below are sized by them, not by the largest tile's: an
+// array larger than its use stays in memory on lavapipe (the 64×64 twin took 2× the time).
+const int FM = BM / (F * WARPS_M), FN = BN / (F * WARPS_N);
 // Row strides in workgroup memory, padded by 16 bytes: a fragment load's rows start on 16-byte
 // boundaries (as cooperative-matrix loads need) in different banks.
 const int SA = BK + 8, SB = BN + 8, SC = F + 4;
@@ -86,12 +89,12 @@ void main() {
   const int warp_row = (warp / WARPS_N) * F * FM, warp_col = (warp % WARPS_N) * F * FN;  // its part of the tile
 
 #ifdef TENSOR_CORES
-  SUMS acc[MAX_FM][MAX_FN];
+  SUMS acc[FM][FN];
   for (int i = 0; i < FM; ++i)
     for (int j = 0; j < FN; ++j) acc[i][j] = SUMS(0.0);
 #else
   // Invocation `lane` holds rows lane / 16 + 2q, column lane % 16 of each fragment.
-  float acc[MAX_FM][MAX_FN][8];
+  float acc[FM][FN][8];
   for (int i = 0; i < FM; ++i)
     for (int j = 0; j < FN; ++j)
       for (int q = 0; q < 8; ++q) acc[i][j][q] = 0.0;
@@ -114,7 +117,7 @@ void main() {
     barrier();
     for (int kf = 0; kf < BK; kf += F) {
 #ifdef TENSOR_CORES
-      OPERAND a[MAX_FM], b[MAX_FN];
+      OPERAND a[FM], b[FN];
       for (int i = 0; i < FM; ++i) coopMatLoadNV(a[i], tile_a, (warp_row + F * i) * SA + kf, SA, false);
       for (int j = 0; j < FN; ++j) coopMatLoadNV(b[j], tile_b, kf * SB + warp_col + F * j, SB, false);
       for (int i = 0; i < FM; ++i)
