@@ -119,11 +119,13 @@ class Builder {
     const Slice corr = all(input).channels(0, kCorrChannels),
                 hidden = all(input).channels(kRefineHiddenOffset, kHiddenChannels),
                 flow_copy = all(input).channels(kRefineFlowOffset, 2);
-    // conv1's share of the inputs fixed for the pair, added at every step.
-    const TensorId constant = like(layer + ".conv1.constant", kRefineHiddenWidth, flow);
-    conv(w.conv1_constant, layer + ".conv1.conv", all(constant_input), all(constant), 1, 1, Activation::none);
     emit(Zero{hidden});
     emit(Copy{all(flow), flow_copy});
+    // conv1's share of the inputs fixed for the pair, added at every step. After the step
+    // input's first values and just before the first correlation, which does not depend on it:
+    // a GPU runs the two under one barrier.
+    const TensorId constant = like(layer + ".conv1.constant", kRefineHiddenWidth, flow);
+    conv(w.conv1_constant, layer + ".conv1.conv", all(constant_input), all(constant), 1, 1, Activation::none);
     const TensorId x1 = like(layer + ".conv1", kRefineHiddenWidth, flow);
     const TensorId x2 = like(layer + ".conv2", w.conv2.out_channels, flow);
     std::array<TensorId, 5> layers{};
@@ -282,8 +284,8 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   // 1/16 → 1/8: the flow, each frame's features merged with its attended ones, the context.
   const TensorId flow8 = b.tensor("flow_s8", 2, h8, w8);
   b.emit(Resample{b.all(flow16), b.all(flow8), 2, false, 2.f});
-  // The two frames' ops side by side, step by step: a GPU runs each step of both without a
-  // barrier between them.
+  // The two frames' feature merges and the context's, side by side step by step: a GPU runs
+  // each step of the three without a barrier between them.
   std::array<TensorId, 2> merged{}, merge_in{}, merge_mid{};
   const std::array<std::pair<TensorId, TensorId>, 2> pair{{{first.f8, att0}, {second.f8, att1}}};
   for (std::size_t f = 0; f < 2; ++f) {
@@ -292,6 +294,11 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
     merge_mid[f] = b.tensor(at + ".0", kMatchingChannels, h8, w8);
     merged[f] = b.tensor(at, kMatchingChannels, h8, w8);
   }
+  const TensorId context_in = b.tensor("context_merge_s8.input", 2 * kContextChannels, h8, w8);
+  const TensorId context_mid = b.tensor("context_merge_s8.0", kContextChannels, h8, w8);
+  const TensorId constant8 = b.tensor("refine_s8.constant_input", kRefineConstantChannels, h8, w8, Storage::persistent,
+                                      ConstantChannels{kContextChannels, 1, Fill::radius_plane});
+  const Slice context8 = b.all(constant8).channels(0, kContextChannels);
   for (std::size_t f = 0; f < 2; ++f) {
     b.emit(Copy{features_of(pair[f].first), b.all(merge_in[f]).channels(0, kMatchingChannels)});
   }
@@ -299,24 +306,20 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
     b.emit(Resample{features_of(pair[f].second), b.all(merge_in[f]).channels(kMatchingChannels, kMatchingChannels), 2,
                     false, 1.f});
   }
+  b.emit(Resample{context_of(first.f8), b.all(context_in).channels(0, kContextChannels), 1, true, 1.f});
+  b.emit(Resample{context_of(att0), b.all(context_in).channels(kContextChannels, kContextChannels), 2, true, 1.f});
   for (std::size_t f = 0; f < 2; ++f) {
     b.conv(w.merge_s8_0, "merge_s8.0", b.all(merge_in[f]), b.all(merge_mid[f]), 1, 1, Activation::gelu);
   }
+  b.conv(w.context_merge_s8_0, "context_merge_s8.0", b.all(context_in), b.all(context_mid), 1, 1, Activation::gelu);
   for (std::size_t f = 0; f < 2; ++f) {
     b.conv(w.merge_s8_2, "merge_s8.2", b.all(merge_mid[f]), b.all(merged[f]), 1, 1, Activation::none);
   }
-  b.emit(StageEnd{str(stage::merge_s8),
-                  {{str(stage::merge_s8), 0, b.all(merged[0])}, {str(stage::merge_s8), 1, b.all(merged[1])}}});
-  const TensorId context_in = b.tensor("context_merge_s8.input", 2 * kContextChannels, h8, w8);
-  b.emit(Resample{context_of(first.f8), b.all(context_in).channels(0, kContextChannels), 1, true, 1.f});
-  b.emit(Resample{context_of(att0), b.all(context_in).channels(kContextChannels, kContextChannels), 2, true, 1.f});
-  const TensorId context_mid = b.tensor("context_merge_s8.0", kContextChannels, h8, w8);
-  b.conv(w.context_merge_s8_0, "context_merge_s8.0", b.all(context_in), b.all(context_mid), 1, 1, Activation::gelu);
-  const TensorId constant8 = b.tensor("refine_s8.constant_input", kRefineConstantChannels, h8, w8, Storage::persistent,
-                                      ConstantChannels{kContextChannels, 1, Fill::radius_plane});
-  const Slice context8 = b.all(constant8).channels(0, kContextChannels);
   b.conv(w.context_merge_s8_2, "context_merge_s8.2", b.all(context_mid), context8, 1, 1, Activation::none);
-  b.emit(StageEnd{str(stage::context_merge_s8), {{str(stage::context_merge_s8), 0, context8}}});
+  b.emit(StageEnd{str(stage::merge_s8),
+                  {{str(stage::merge_s8), 0, b.all(merged[0])},
+                   {str(stage::merge_s8), 1, b.all(merged[1])},
+                   {str(stage::context_merge_s8), 0, context8}}});
 
   // 1/8 refinement.
   b.refinement(w.refine_s8, "refine_s8", stage::scale_s8, b.all(merged[0]), b.all(merged[1]), flow8, constant8,
