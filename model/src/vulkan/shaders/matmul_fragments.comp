@@ -53,9 +53,12 @@ layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the ad
 const int BM = 16 * TM, BN = 16 * TN, BK = 32;  // the workgroup's tile and K step
 const int F = 16;                               // a fragment: 16×16, K 16
 const int WARPS = INVOCATIONS / 32, WARPS_N = 2, WARPS_M = WARPS / WARPS_N;
-// A subgroup's fragments. The arrays below are sized by them, not by the largest tile's: an
-// array larger than its use stays in memory on lavapipe (the 64×64 twin took 2× the time).
+// A subgroup's fragments. The twin's arrays are sized by them, not by the largest tile's: an
+// array larger than its use stays in memory on lavapipe (the 64×64 twin took 2× the time). The
+// cooperative matrices' arrays keep a fixed size, the largest tile's (a form drivers have long
+// compiled), of which a smaller tile uses part.
 const int FM = BM / (F * WARPS_M), FN = BN / (F * WARPS_N);
+const int MAX_FM = 2, MAX_FN = 4;
 // Row strides in workgroup memory, padded by 16 bytes: a fragment load's rows start on 16-byte
 // boundaries (as cooperative-matrix loads need) in different banks.
 const int SA = BK + 8, SB = BN + 8, SC = F + 4;
@@ -89,7 +92,7 @@ void main() {
   const int warp_row = (warp / WARPS_N) * F * FM, warp_col = (warp % WARPS_N) * F * FN;  // its part of the tile
 
 #ifdef TENSOR_CORES
-  SUMS acc[FM][FN];
+  SUMS acc[MAX_FM][MAX_FN];
   for (int i = 0; i < FM; ++i)
     for (int j = 0; j < FN; ++j) acc[i][j] = SUMS(0.0);
 #else
@@ -117,7 +120,7 @@ void main() {
     barrier();
     for (int kf = 0; kf < BK; kf += F) {
 #ifdef TENSOR_CORES
-      OPERAND a[FM], b[FN];
+      OPERAND a[MAX_FM], b[MAX_FN];
       for (int i = 0; i < FM; ++i) coopMatLoadNV(a[i], tile_a, (warp_row + F * i) * SA + kf, SA, false);
       for (int j = 0; j < FN; ++j) coopMatLoadNV(b[j], tile_b, kf * SB + warp_col + F * j, SB, false);
       for (int i = 0; i < FM; ++i)
