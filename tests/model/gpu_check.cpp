@@ -61,8 +61,8 @@ ImageView view(const std::vector<std::uint8_t>& bgr, const Size& s) {
   return ImageView{bgr.data(), s.w, s.h, static_cast<std::ptrdiff_t>(s.w) * 3, ChannelOrder::bgr};
 }
 
-// NEUFLOW_VULKAN_PRODUCTS (and the scalar products' NEUFLOW_VULKAN_GEMM_TILE) for the sessions
-// made while it lives.
+// NEUFLOW_VULKAN_PRODUCTS (and the products' NEUFLOW_VULKAN_GEMM_TILE) for the sessions made
+// while it lives.
 class Products {
  public:
   explicit Products(const char* kernels, const char* tile = "auto") {
@@ -134,7 +134,7 @@ double milliseconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// `tile`: the scalar products' (NEUFLOW_VULKAN_GEMM_TILE); "auto" chooses by the grid.
+// `tile`: the products' (NEUFLOW_VULKAN_GEMM_TILE); "auto" chooses by the grid.
 void time_row(const std::shared_ptr<const FlowModel>& model, int device, const Size& s, Precision precision,
               const char* products, int frames, int pair_count, const char* tile = "auto") {
   const Products chosen(products, tile);

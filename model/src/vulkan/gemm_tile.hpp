@@ -28,7 +28,7 @@ struct GemmTile {
 
 inline constexpr GemmTile kGemmTile32{2, 2}, kGemmTile64{4, 4}, kGemmTile128{8, 8};
 
-// How a device's scalar products choose their tiles.
+// How a device's products (scalar and on fragments alike) choose their tiles.
 struct GemmTiles {
   int forced = 0;      // 32, 64 or 128: that tile everywhere; 0: by the grid
   long wide_grid = 1;  // the fewest workgroups that keep the device busy
