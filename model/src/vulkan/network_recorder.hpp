@@ -237,6 +237,7 @@ class VulkanNetwork::Recorder {
     const graph::TensorDesc& d = net_.graph_.tensors.at(s.tensor);
     return {&net_.buffer_of(s.tensor, frames_), s.channel, s.c, d.h, d.w};
   }
+  const graph::TensorTable& tensors() const { return net_.graph_.tensors; }
   const Buffer& weights() const { return net_.weights_->buffer; }
   const DeviceWeights& device_weights() const { return *net_.weights_; }
   // How the stride-1 3×3 convolutions run (conv_algorithm.hpp).

@@ -15,9 +15,10 @@ namespace neuflow::model::vulkan {
 // Every pipeline shares one push-constant range of this size (VulkanDevice's layout): the
 // smallest maxPushConstantsSize Vulkan guarantees.
 inline constexpr std::size_t kMaxPushConstantBytes = 128;
-// Every shader's storage buffers are bindings 0 to 4 of one set layout (the refinement's fused
-// step needs five; every GPU this runs on allows far more per stage than Vulkan's minimum of 4).
-inline constexpr std::size_t kShaderBindings = 5;
+// Every shader's storage buffers are bindings 0 to 5 of one set layout (the fused Winograd
+// convolution on fragments needs six: the input's two parts; every GPU this runs on allows far
+// more per stage than Vulkan's minimum of 4).
+inline constexpr std::size_t kShaderBindings = 6;
 
 struct ShaderInfo {
   const char* name;

@@ -7,6 +7,7 @@
 
 #include "network_dims.hpp"
 #include "vulkan/half_float.hpp"
+#include "vulkan/inputs_in_parts.hpp"
 #include "vulkan/network_recorder.hpp"
 #include "vulkan/one_shot_commands.hpp"
 
@@ -38,8 +39,8 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
   // them, as no write-after-read on a shared buffer orders them (16 % more memory at full HD than
   // packing tensors as tightly as their live ranges allow, 4 barriers fewer a streamed frame).
   constexpr int kApart = 2;
-  plan_ = graph::plan_memory(graph_.tensors,
-                             graph::live_ranges<DeviceTensor>(graph_.tensors, {&graph_.encode, &graph_.flow}), kApart);
+  plan_ = graph::plan_memory(graph_.tensors, planned_live_ranges(graph_.tensors, graph_.encode, graph_.flow, conv_),
+                             kApart);
   allocate_tensors();
 
   // The buffers release themselves; the pool and fence are released here if setting up fails.

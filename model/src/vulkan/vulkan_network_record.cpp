@@ -10,6 +10,8 @@
 #include <variant>
 #include <vector>
 
+#include "graph/network_graph.hpp"
+#include "vulkan/inputs_in_parts.hpp"
 #include "vulkan/network_recorder.hpp"
 #include "vulkan/one_shot_commands.hpp"
 #include "vulkan/ops/record_op.hpp"
@@ -34,9 +36,14 @@ namespace {
 //   stage ends lie between them (the next scale's flow, the upsampler's input);
 // - both parts of a concatenation (a copy or a resample, then a resample into the channels after
 //   it), in the second's dispatch, where no op between them touches the output or changes the
-//   first part's input.
+//   first part's input;
+// - before all of these: a concatenation (one or two copies or resamples writing all of a
+//   transient tensor's channels) that only one-dispatch Winograd convolutions read, not
+//   recorded at all: they read its parts where they lie (ConvInputParts), where nothing writes
+//   the parts' memory until the last of them has run.
 struct Fusions {
   std::vector<bool> absorbed;
+  std::vector<std::optional<ConvInputParts>> conv_parts;                // of a convolution
   std::vector<const graph::RefineUpdate*> update_first;                 // of a correlation
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;  // of a LayerNorm
   std::vector<bool> pyramid;                                            // starts here
@@ -44,24 +51,9 @@ struct Fusions {
   std::vector<std::optional<graph::Resample>> resample_after;           // of a RefineUpdate
 };
 
-graph::Accesses accesses_of(const graph::Op<DeviceTensor>& op) {
-  return std::visit([](const auto& o) { return o.accesses(); }, op);
-}
-
-bool mentions(const std::vector<graph::Slice>& slices, graph::TensorId tensor) {
-  return std::any_of(slices.begin(), slices.end(), [&](const graph::Slice& s) { return s.tensor == tensor; });
-}
-
 bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
   const graph::Accesses a = accesses_of(op);
   return mentions(a.reads, tensor) || mentions(a.writes, tensor);
-}
-
-// A copy or a resample as the first part of a concatenation (a copy is a resample of factor 1).
-std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op) {
-  if (const auto* resample = std::get_if<graph::Resample>(&op)) return *resample;
-  if (const auto* copy = std::get_if<graph::Copy>(&op)) return graph::Resample{copy->in, copy->out, 1, false, 1.f};
-  return std::nullopt;
 }
 
 // The resample after ops[i] that writes the channels right after its output's, with nothing
@@ -81,6 +73,34 @@ std::optional<std::size_t> concat_second(const graph::OpList<DeviceTensor>& ops,
   return std::nullopt;
 }
 
+bool overlap(const View& a, const View& b) {
+  return a.buffer == b.buffer && a.offset() < b.offset() + b.count() && b.offset() < a.offset() + a.count();
+}
+
+// The concatenation that ops[i] starts, where the convolutions that read it can read its parts
+// in place (inputs_in_parts.hpp): marks its ops absorbed and gives those convolutions the parts.
+// The memory plan keeps the parts' sources apart from what those ops write; checked here all the
+// same, as the cost of a wrong plan would be a wrong flow.
+void find_input_in_parts(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, std::size_t i,
+                         Recorder& r, Fusions& f) {
+  const auto found = input_in_parts_at(ops, tensors, i, r.conv_algorithm());
+  if (!found) return;
+  std::vector<View> sources{r.view(found->parts.first.in)};
+  if (found->parts.second) sources.push_back(r.view(found->parts.second->in));
+  for (std::size_t m = i + 1; m <= found->readers.back(); ++m) {
+    if (std::find(found->writers.begin(), found->writers.end(), m) != found->writers.end()) continue;
+    for (const graph::Slice& written : accesses_of(ops[m].op).writes) {
+      const View v = r.view(written);
+      if (std::any_of(sources.begin(), sources.end(), [&](const View& s) { return overlap(v, s); })) {
+        throw std::logic_error("the Vulkan memory plan overlaps a concatenation's part with what " +
+                               graph::describe(ops[m].op) + " writes before the part is read");
+      }
+    }
+  }
+  for (const std::size_t w : found->writers) f.absorbed[w] = true;
+  for (const std::size_t reader : found->readers) f.conv_parts[reader] = found->parts;
+}
+
 // The three poolings from ops[i] on, where they chain and the input's sides are multiples of 8.
 std::optional<std::array<const graph::AvgPool2x*, 3>> pyramid_at(const graph::OpList<DeviceTensor>& ops,
                                                                  const graph::TensorTable& tensors, std::size_t i) {
@@ -94,17 +114,21 @@ std::optional<std::array<const graph::AvgPool2x*, 3>> pyramid_at(const graph::Op
   return pools;
 }
 
-Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, bool observing) {
+Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, Recorder& r) {
   Fusions f{std::vector<bool>(ops.size()),
+            std::vector<std::optional<ConvInputParts>>(ops.size()),
             std::vector<const graph::RefineUpdate*>(ops.size()),
             std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()),
             std::vector<bool>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
+    if (!f.absorbed[i]) find_input_in_parts(ops, tensors, i, r, f);
+  }
+  for (std::size_t i = 0; i < ops.size(); ++i) {
     if (f.absorbed[i]) continue;
     if (const auto first = as_resample(ops[i].op); first && !f.concat_first[i]) {
-      if (const auto j = concat_second(ops, i, *first); j && !f.concat_first[*j]) {
+      if (const auto j = concat_second(ops, i, *first); j && !f.concat_first[*j] && !f.absorbed[*j]) {
         f.absorbed[i] = true;
         f.concat_first[*j] = first;
         continue;
@@ -115,7 +139,7 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
       f.absorbed[i + 1] = f.absorbed[i + 2] = true;
       continue;
     }
-    if (const auto* update = std::get_if<graph::RefineUpdate>(&ops[i].op); update && !observing) {
+    if (const auto* update = std::get_if<graph::RefineUpdate>(&ops[i].op); update && !r.observing()) {
       std::size_t j = i + 1;
       while (j < ops.size() && std::holds_alternative<graph::StageEnd>(ops[j].op)) ++j;
       const auto* corr = j < ops.size() ? std::get_if<graph::LocalCorrelation>(&ops[j].op) : nullptr;
@@ -123,7 +147,7 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
           corr->out.tensor == update->flow_copy.tensor) {
         f.absorbed[i] = true;
         f.update_first[j] = update;
-      } else if (const auto then = j < ops.size() ? as_resample(ops[j].op) : std::nullopt;
+      } else if (const auto then = j < ops.size() && !f.absorbed[j] ? as_resample(ops[j].op) : std::nullopt;
                  then && then->in.tensor == update->flow.tensor && then->in.channel == update->flow.channel &&
                  then->in.c == 2 && !then->relu) {
         f.absorbed[j] = true;
@@ -148,7 +172,7 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
 }  // namespace
 
 void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) {
-  const Fusions f = find_fusions(ops, graph_.tensors, r.observing());
+  const Fusions f = find_fusions(ops, graph_.tensors, r);
   // One dispatch writes every level of the pyramid (and the frame's input with it): only where
   // the plan gave them buffers of their own.
   const auto own_buffers = [&](const std::array<const graph::AvgPool2x*, 3>& pools) {
@@ -187,6 +211,8 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);
     } else if (f.resample_after[i]) {
       record_op(r, std::get<graph::RefineUpdate>(op), &*f.resample_after[i]);
+    } else if (f.conv_parts[i]) {
+      record_op(r, std::get<graph::Conv2d<DeviceTensor>>(op), *f.conv_parts[i]);
     } else if (f.concat_first[i]) {
       record_op(r, *f.concat_first[i], std::get<graph::Resample>(op));
     } else {
@@ -214,7 +240,7 @@ const graph::OpList<DeviceTensor>& VulkanNetwork::flow_ops(const Iterations& ite
     throw std::logic_error("the network graph's tensors depend on its iterations");
   }
   graph::check_shapes(g);
-  graph::check_plan(g.tensors, plan_, graph::live_ranges<DeviceTensor>(g.tensors, {&g.encode, &g.flow}));
+  graph::check_plan(g.tensors, plan_, planned_live_ranges(g.tensors, g.encode, g.flow, conv_));
   return flow_ops_.emplace(key, std::move(g.flow)).first->second;
 }
 

@@ -5,6 +5,7 @@
 
 #include "graph/ops.hpp"
 #include "vulkan/device_weights.hpp"
+#include "vulkan/inputs_in_parts.hpp"
 #include "vulkan/network_recorder.hpp"
 
 namespace neuflow::model::vulkan {
@@ -19,6 +20,9 @@ void record_op(Recorder& r, const graph::AvgPool2x& op);
 // Three poolings in a chain, of an input whose sides are multiples of 8, in one dispatch.
 void record_op(Recorder& r, const std::array<const graph::AvgPool2x*, 3>& ops);
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op);
+// The input read where its concatenation's parts lie (inputs_in_parts.hpp), in the one-dispatch
+// Winograd forms.
+void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const ConvInputParts& parts);
 void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::Attention& op);
 // `then`: a folded BatchNorm applied to the output in the same dispatch (or nullptr).

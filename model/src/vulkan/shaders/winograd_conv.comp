@@ -20,9 +20,11 @@ layout(std430, binding = 0) readonly buffer Weights { VALUE u[]; };
 layout(std430, binding = 1) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
+layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input's second part
 #include "params/winograd_conv_params.h"
 #include "activate.glsl"
 #define READS_INPUT_TILES
+#define INPUT_IN_PARTS
 #define WRITES_OUTPUT_TILES
 #include "winograd_tile_io.glsl"
 
@@ -37,7 +39,7 @@ shared float staged[36 * STEP * (TILES + CHANNELS)];
 void stage_tile(int ci, int t, int k, int slot) {
   const int ty = t / p.tiles_x, tx = t - ty * p.tiles_x;
   float v[36];
-  input_tile(p.in_off + ci * p.h * p.w, ty, tx, ci < p.in_c && t < p.tiles, v);
+  input_tile(ci, ty, tx, ci < p.in_c && t < p.tiles, v);
   for (int i = 0; i < 36; ++i) staged[(i * STEP + k) * TILES + slot] = v[i];
 }
 

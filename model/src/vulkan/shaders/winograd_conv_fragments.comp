@@ -32,9 +32,11 @@ layout(std430, binding = 1) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 layout(std430, binding = 4) readonly buffer Filters { float16_t filters[]; };
+layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input's second part
 #include "params/winograd_conv_params.h"
 #include "activate.glsl"
 #define READS_INPUT_TILES
+#define INPUT_IN_PARTS
 #include "winograd_tile_io.glsl"
 
 const int F = 16;  // a fragment: 16×16, K 16; the workgroup's tiles, channels and K step
@@ -98,7 +100,7 @@ void main() {
       const int k = pair / F, t = t0 + pair % F, ci = c0 + k;
       const int ty = t / p.tiles_x, tx = t - ty * p.tiles_x;
       float v[36];
-      input_tile(p.in_off + ci * plane, ty, tx, ci < p.in_c && t < p.tiles, v);
+      input_tile(ci, ty, tx, ci < p.in_c && t < p.tiles, v);
       for (int i = 0; i < 36; ++i) points[i * F * F + pair] = float16_t(v[i]);
     }
     barrier();

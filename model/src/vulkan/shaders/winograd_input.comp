@@ -13,13 +13,12 @@ layout(std430, binding = 2) writeonly buffer Points { float points[]; };
 #include "winograd_tile_io.glsl"
 
 void main() {
-  const int plane = p.h * p.w;
   const int stride = p.c * p.tiles;  // between points
   FOR_EACH(i, p.c * p.tiles) {
     const int ci = i / p.tiles, t = i - ci * p.tiles;
     const int ty = t / p.tiles_x, tx = t - ty * p.tiles_x;
     float v[36];
-    input_tile(p.in_off + ci * plane, ty, tx, true, v);
+    input_tile(ci, ty, tx, true, v);
     for (int k = 0; k < 36; ++k) points[k * stride + i] = v[k];
   }
 }

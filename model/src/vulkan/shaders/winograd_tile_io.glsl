@@ -1,20 +1,43 @@
 // F(4×4, 3×3)'s tiles read from and written to the planar tensors, shared by the split shaders
 // and the fused one. The including shader defines which it uses and declares what they touch:
-// READS_INPUT_TILES for input_tile, which reads `src` (p.h × p.w planes); WRITES_OUTPUT_TILES
+// READS_INPUT_TILES for input_tile, which reads `src` (p.h × p.w planes at p.in_off; with
+// INPUT_IN_PARTS, `src` and `src2` as winograd_conv_params.h describes); WRITES_OUTPUT_TILES
 // for store_output_tile, which writes `dst` and reads `addend` (p.out_off, p.add_off, p.act).
 #include "winograd_transforms.glsl"
 
 #ifdef READS_INPUT_TILES
-// Bᵀ d B of the 6×6 input tile d around 4×4 output tile (ty, tx) of the plane at `base`: zeros
-// outside the input (padding 1), and everywhere where !inside. Point 6 i + j in v[6 i + j].
-void input_tile(int base, int ty, int tx, bool inside, out float v[36]) {
+#ifdef INPUT_IN_PARTS
+// Input channel ci at (y, x) where the concatenation's parts lie (winograd_conv_params.h): `src`
+// and the including shader's `src2`, each upsampled by 2^shift, through ReLU, scaled, as the
+// resamples that would have written the concatenated input compute it.
+float input_value(int ci, int y, int x) {
+  float v;
+  if (ci < p.part_c) {
+    const int h = p.h >> p.shift, w = p.w >> p.shift;
+    v = float(src[p.in_off + (ci * h + (y >> p.shift)) * w + (x >> p.shift)]);
+    if ((p.relu_parts & 1) != 0) v = max(v, 0.0);
+    return v * p.scale;
+  }
+  const int h = p.h >> p.shift2, w = p.w >> p.shift2;
+  v = float(src2[p.in2_off + ((ci - p.part_c) * h + (y >> p.shift2)) * w + (x >> p.shift2)]);
+  if ((p.relu_parts & 2) != 0) v = max(v, 0.0);
+  return v * p.scale2;
+}
+#else
+float input_value(int ci, int y, int x) { return float(src[p.in_off + (ci * p.h + y) * p.w + x]); }
+#endif
+
+// Bᵀ d B of the 6×6 input tile d of channel ci around 4×4 output tile (ty, tx) (p.h × p.w
+// planes): zeros outside the input (padding 1), and everywhere where !inside. Point 6 i + j in
+// v[6 i + j].
+void input_tile(int ci, int ty, int tx, bool inside, out float v[36]) {
   const int y0 = 4 * ty - 1, x0 = 4 * tx - 1;
   float d[6][6];
   for (int r = 0; r < 6; ++r) {
     const int y = y0 + r;
     for (int c = 0; c < 6; ++c) {
       const int x = x0 + c;
-      d[r][c] = (inside && y >= 0 && y < p.h && x >= 0 && x < p.w) ? float(src[base + y * p.w + x]) : 0.0;
+      d[r][c] = (inside && y >= 0 && y < p.h && x >= 0 && x < p.w) ? input_value(ci, y, x) : 0.0;
     }
   }
   float cols[6][6];  // Bᵀ d: each column transformed

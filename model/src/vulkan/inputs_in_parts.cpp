@@ -1,0 +1,119 @@
+#include "vulkan/inputs_in_parts.hpp"
+
+#include <algorithm>
+#include <variant>
+
+#include "vulkan/ops/winograd.hpp"
+
+namespace neuflow::model::vulkan {
+
+graph::Accesses accesses_of(const graph::Op<DeviceTensor>& op) {
+  return std::visit([](const auto& o) { return o.accesses(); }, op);
+}
+
+bool mentions(const std::vector<graph::Slice>& slices, graph::TensorId tensor) {
+  return std::any_of(slices.begin(), slices.end(), [&](const graph::Slice& s) { return s.tensor == tensor; });
+}
+
+std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op) {
+  if (const auto* resample = std::get_if<graph::Resample>(&op)) return *resample;
+  if (const auto* copy = std::get_if<graph::Copy>(&op)) return graph::Resample{copy->in, copy->out, 1, false, 1.f};
+  return std::nullopt;
+}
+
+namespace {
+
+bool power_of_two(int factor) { return factor > 0 && (factor & (factor - 1)) == 0; }
+
+}  // namespace
+
+bool reads_input_in_parts(ConvAlgorithm conv, const graph::Conv2d<DeviceTensor>& op,
+                          const graph::TensorTable& tensors) {
+  const graph::TensorDesc& out = tensors.at(op.out.tensor);
+  return conv == ConvAlgorithm::winograd_fused && takes_winograd(conv, op, out.h, out.w);
+}
+
+std::optional<InputInParts> input_in_parts_at(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors,
+                                              std::size_t i, ConvAlgorithm conv) {
+  const auto first = as_resample(ops[i].op);
+  if (!first || first->out.channel != 0) return std::nullopt;
+  const graph::TensorId x = first->out.tensor;
+  const graph::TensorDesc& desc = tensors.at(x);
+  if (desc.storage != graph::Storage::transient || desc.constant) return std::nullopt;
+  InputInParts found{{*first, std::nullopt}, {i}, {}};
+  std::size_t k = i + 1;
+  if (first->out.c < desc.c) {  // the second part: the next op that touches x
+    for (; k < ops.size(); ++k) {
+      const graph::Accesses a = accesses_of(ops[k].op);
+      if (mentions(a.reads, x) || mentions(a.writes, x)) break;
+    }
+    const auto second = k < ops.size() ? as_resample(ops[k].op) : std::nullopt;
+    if (!second || second->out.tensor != x || second->out.channel != first->out.c ||
+        first->out.c + second->out.c != desc.c) {
+      return std::nullopt;
+    }
+    found.parts.second = second;
+    found.writers.push_back(k++);
+  }
+  for (const auto& part : {std::optional(found.parts.first), found.parts.second}) {
+    if (part && (!power_of_two(part->factor) || part->in.tensor == x)) return std::nullopt;
+  }
+  // The readers, up to the next op that writes x again; nothing may write a part's source
+  // tensor before the last of them.
+  std::vector<std::size_t> writes_source;
+  for (; k < ops.size(); ++k) {
+    const graph::Accesses a = accesses_of(ops[k].op);
+    if (mentions(a.writes, found.parts.first.in.tensor) ||
+        (found.parts.second && mentions(a.writes, found.parts.second->in.tensor))) {
+      writes_source.push_back(k);
+    }
+    if (!mentions(a.reads, x)) {
+      if (mentions(a.writes, x)) break;
+      continue;
+    }
+    const auto* c = std::get_if<graph::Conv2d<DeviceTensor>>(&ops[k].op);
+    if (!c || c->in.tensor != x || c->in.channel != 0 || c->in.c != desc.c || mentions(a.writes, x) ||
+        (c->addend && c->addend->tensor == x) || !reads_input_in_parts(conv, *c, tensors)) {
+      return std::nullopt;
+    }
+    found.readers.push_back(k);
+  }
+  if (found.readers.empty()) return std::nullopt;
+  if (std::any_of(writes_source.begin(), writes_source.end(),
+                  [&](std::size_t w) { return w <= found.readers.back(); })) {
+    return std::nullopt;
+  }
+  return found;
+}
+
+namespace {
+
+// `ranges` with each read-in-parts source of `ops` (which start at op index `first_op`) living
+// until its last reader.
+void extend_live_ranges(graph::LiveRanges& ranges, const graph::OpList<DeviceTensor>& ops,
+                        const graph::TensorTable& tensors, int first_op, ConvAlgorithm conv) {
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    const auto found = input_in_parts_at(ops, tensors, i, conv);
+    if (!found) continue;
+    const int last = first_op + static_cast<int>(found->readers.back());
+    for (std::size_t p = 0; p < found->writers.size(); ++p) {
+      const graph::Resample& part = p == 0 ? found->parts.first : *found->parts.second;
+      const int read_at = first_op + static_cast<int>(found->writers[p]);
+      for (graph::LiveRange& r : ranges[static_cast<std::size_t>(part.in.tensor)]) {
+        if (r.first <= read_at && read_at <= r.last) r.last = std::max(r.last, last);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+graph::LiveRanges planned_live_ranges(const graph::TensorTable& tensors, const graph::OpList<DeviceTensor>& encode,
+                                      const graph::OpList<DeviceTensor>& flow, ConvAlgorithm conv) {
+  graph::LiveRanges ranges = graph::live_ranges<DeviceTensor>(tensors, {&encode, &flow});
+  extend_live_ranges(ranges, encode, tensors, 0, conv);
+  extend_live_ranges(ranges, flow, tensors, static_cast<int>(encode.size()), conv);
+  return ranges;
+}
+
+}  // namespace neuflow::model::vulkan
