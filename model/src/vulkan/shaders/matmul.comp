@@ -34,12 +34,24 @@ layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the ad
 
 #include "gemm_operands.glsl"
 
+// The staged operands in the type they are stored in: fp16 tensors stay fp16 in workgroup
+// memory (exactly: they are widened to fp32 as they are multiplied, as before), which halves it
+// (8 KiB for a 128×128 tile) and so leaves room for more workgroups at once. The split Winograd's
+// transformed tiles are fp32 in either precision, so its products stage fp32.
+#if defined(FP16) && !defined(WINOGRAD_GEMM)
+#define STAGED float16_t
+const int PAD = 2;
+#else
+#define STAGED float
+const int PAD = 1;
+#endif
+
 const int BM = 16 * TM, BN = 16 * TN, BK = 16;
-// tile_a's rows padded by one: the 16 invocations that store a column's 16 k values (adjacent
-// in the weights) then write 16 different banks, where a row of 32, 64 or 128 floats put them
-// all in one.
-shared float tile_a[BK][BM + 1];
-shared float tile_b[BK][BN];
+// tile_a's rows padded by one 32-bit word: the 16 invocations that store a column's 16 k values
+// (adjacent in the weights) then write 16 different banks, where a row of 32, 64 or 128 values
+// put them in one or two.
+shared STAGED tile_a[BK][BM + PAD];
+shared STAGED tile_b[BK][BN];
 
 void main() {
   const int tx = int(gl_LocalInvocationID.x), ty = int(gl_LocalInvocationID.y);
@@ -75,9 +87,9 @@ void main() {
   for (int k0 = 0; k0 < K; k0 += BK) {
     for (int r = 0; r < TM; ++r) {
       const int e = tid + 256 * r;
-      tile_a[e % BK][e / BK] = next_a[r];
+      tile_a[e % BK][e / BK] = STAGED(next_a[r]);
     }
-    for (int r = 0; r < TN; ++r) tile_b[b_row + r][tid % BN] = next_b[r];
+    for (int r = 0; r < TN; ++r) tile_b[b_row + r][tid % BN] = STAGED(next_b[r]);
     barrier();
     if (k0 + BK < K) {
       for (int r = 0; r < TM; ++r) {
@@ -93,8 +105,8 @@ void main() {
     }
     for (int kk = 0; kk < BK; ++kk) {
       float av[TM], bv[TN];
-      for (int i = 0; i < TM; ++i) av[i] = tile_a[kk][ty + 16 * i];
-      for (int j = 0; j < TN; ++j) bv[j] = tile_b[kk][tx + 16 * j];
+      for (int i = 0; i < TM; ++i) av[i] = float(tile_a[kk][ty + 16 * i]);
+      for (int j = 0; j < TN; ++j) bv[j] = float(tile_b[kk][tx + 16 * j]);
       for (int i = 0; i < TM; ++i)
         for (int j = 0; j < TN; ++j) acc[i][j] = fma(av[i], bv[j], acc[i][j]);
     }
