@@ -58,18 +58,17 @@ std::optional<InputInParts> input_in_parts_at(const graph::OpList<DeviceTensor>&
   for (const auto& part : {std::optional(found.parts.first), found.parts.second}) {
     if (part && (!power_of_two(part->factor) || part->in.tensor == x)) return std::nullopt;
   }
-  // The readers, up to the next op that writes x again; nothing may write a part's source
-  // tensor before the last of them.
-  std::vector<std::size_t> writes_source;
+  // The readers, up to the next op that writes all of x without reading it (a new live range);
+  // no other op may write x, as its channels are never written here.
   for (; k < ops.size(); ++k) {
     const graph::Accesses a = accesses_of(ops[k].op);
-    if (mentions(a.writes, found.parts.first.in.tensor) ||
-        (found.parts.second && mentions(a.writes, found.parts.second->in.tensor))) {
-      writes_source.push_back(k);
-    }
     if (!mentions(a.reads, x)) {
-      if (mentions(a.writes, x)) break;
-      continue;
+      if (!mentions(a.writes, x)) continue;
+      const bool whole = !a.partial_rows && std::any_of(a.writes.begin(), a.writes.end(), [&](const graph::Slice& w) {
+        return w.tensor == x && w.channel == 0 && w.c == desc.c;
+      });
+      if (whole) break;
+      return std::nullopt;
     }
     const auto* c = std::get_if<graph::Conv2d<DeviceTensor>>(&ops[k].op);
     if (!c || c->in.tensor != x || c->in.channel != 0 || c->in.c != desc.c || mentions(a.writes, x) ||
@@ -79,9 +78,12 @@ std::optional<InputInParts> input_in_parts_at(const graph::OpList<DeviceTensor>&
     found.readers.push_back(k);
   }
   if (found.readers.empty()) return std::nullopt;
-  if (std::any_of(writes_source.begin(), writes_source.end(),
-                  [&](std::size_t w) { return w <= found.readers.back(); })) {
-    return std::nullopt;
+  // Nothing may write a part's source from where the part was read to the last reader.
+  for (std::size_t p = 0; p < found.writers.size(); ++p) {
+    const graph::TensorId source = (p == 0 ? found.parts.first : *found.parts.second).in.tensor;
+    for (std::size_t m = found.writers[p] + 1; m <= found.readers.back(); ++m) {
+      if (mentions(accesses_of(ops[m].op).writes, source)) return std::nullopt;
+    }
   }
   return found;
 }

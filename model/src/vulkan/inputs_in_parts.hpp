@@ -4,7 +4,7 @@
 // channels), those convolutions read its parts where they lie (winograd_conv_params.h), which
 // saves the concatenation's dispatch, its barrier and its bytes (the merges' inputs at 1/8, the
 // upsampler's). Each part's source must then live until the last of those convolutions has run:
-// the memory plan takes the ranges extend_live_ranges() gives it.
+// the memory plan takes the ranges planned_live_ranges() gives it.
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -31,7 +31,7 @@ std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op);
 
 struct InputInParts {
   ConvInputParts parts;
-  std::vector<std::size_t> writers;  // the concatenation's ops, not recorded
+  std::vector<std::size_t> writers;  // the concatenation's ops, not recorded: the first part's, the second's
   std::vector<std::size_t> readers;  // the convolutions that read its parts
 };
 

@@ -23,6 +23,8 @@ namespace neuflow::model::vulkan {
 namespace {
 
 // Ops recorded as part of another's dispatch, which saves a dispatch and a barrier each:
+// - a scale's first step input values (its hidden state zeroed, the flow copied into it), with its
+//   first correlation, where no op between them touches the step input or the flow;
 // - a refinement step's update, with the next step's correlation where only stage ends lie
 //   between them (unobserved, a stage end reads nothing: nothing else touches the flow, the
 //   update or the step input there); an observed pass keeps them apart, its observer reading
@@ -43,12 +45,13 @@ namespace {
 //   the parts' memory until the last of them has run.
 struct Fusions {
   std::vector<bool> absorbed;
-  std::vector<std::optional<ConvInputParts>> conv_parts;                // of a convolution
-  std::vector<const graph::RefineUpdate*> update_first;                 // of a correlation
-  std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;  // of a LayerNorm
-  std::vector<bool> pyramid;                                            // starts here
-  std::vector<std::optional<graph::Resample>> concat_first;             // of a resample
-  std::vector<std::optional<graph::Resample>> resample_after;           // of a RefineUpdate
+  std::vector<std::optional<ConvInputParts>> conv_parts;                       // of a convolution
+  std::vector<const graph::RefineUpdate*> update_first;                        // of a correlation
+  std::vector<std::pair<const graph::Zero*, const graph::Copy*>> start_first;  // of a correlation
+  std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;         // of a LayerNorm
+  std::vector<bool> pyramid;                                                   // starts here
+  std::vector<std::optional<graph::Resample>> concat_first;                    // of a resample
+  std::vector<std::optional<graph::Resample>> resample_after;                  // of a RefineUpdate
 };
 
 bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
@@ -85,20 +88,45 @@ void find_input_in_parts(const graph::OpList<DeviceTensor>& ops, const graph::Te
                          Recorder& r, Fusions& f) {
   const auto found = input_in_parts_at(ops, tensors, i, r.conv_algorithm());
   if (!found) return;
-  std::vector<View> sources{r.view(found->parts.first.in)};
-  if (found->parts.second) sources.push_back(r.view(found->parts.second->in));
-  for (std::size_t m = i + 1; m <= found->readers.back(); ++m) {
-    if (std::find(found->writers.begin(), found->writers.end(), m) != found->writers.end()) continue;
-    for (const graph::Slice& written : accesses_of(ops[m].op).writes) {
-      const View v = r.view(written);
-      if (std::any_of(sources.begin(), sources.end(), [&](const View& s) { return overlap(v, s); })) {
-        throw std::logic_error("the Vulkan memory plan overlaps a concatenation's part with what " +
-                               graph::describe(ops[m].op) + " writes before the part is read");
+  for (std::size_t p = 0; p < found->writers.size(); ++p) {
+    const View source = r.view((p == 0 ? found->parts.first : *found->parts.second).in);
+    for (std::size_t m = found->writers[p] + 1; m <= found->readers.back(); ++m) {
+      if (std::find(found->writers.begin(), found->writers.end(), m) != found->writers.end()) continue;
+      for (const graph::Slice& written : accesses_of(ops[m].op).writes) {
+        if (overlap(r.view(written), source)) {
+          throw std::logic_error("the Vulkan memory plan overlaps a concatenation's part with what " +
+                                 graph::describe(ops[m].op) + " writes before the part is read");
+        }
       }
     }
   }
   for (const std::size_t w : found->writers) f.absorbed[w] = true;
   for (const std::size_t reader : found->readers) f.conv_parts[reader] = found->parts;
+}
+
+// The step input's first values before a scale's first correlation ops[i]: the zeroed hidden
+// state and the flow's copy (their indices), where no other op since touches the step input or
+// the flow.
+std::optional<std::pair<std::size_t, std::size_t>> step_start_before(const graph::OpList<DeviceTensor>& ops,
+                                                                     std::size_t i, const graph::LocalCorrelation& corr,
+                                                                     const Fusions& f) {
+  std::optional<std::size_t> zero, copy;
+  for (std::size_t k = i; k-- > 0 && !(zero && copy);) {
+    if (!touches(ops[k].op, corr.out.tensor) && !touches(ops[k].op, corr.flow.tensor)) continue;
+    const auto* z = std::get_if<graph::Zero>(&ops[k].op);
+    const auto* c = std::get_if<graph::Copy>(&ops[k].op);
+    if (f.absorbed[k]) return std::nullopt;
+    if (z && !zero && z->out.tensor == corr.out.tensor) {
+      zero = k;
+    } else if (c && !copy && c->out.tensor == corr.out.tensor && c->in.tensor == corr.flow.tensor &&
+               c->in.channel == corr.flow.channel && c->in.c == 2) {
+      copy = k;
+    } else {
+      return std::nullopt;
+    }
+  }
+  if (!zero || !copy) return std::nullopt;
+  return std::pair{*zero, *copy};
 }
 
 // The three poolings from ops[i] on, where they chain and the input's sides are multiples of 8.
@@ -118,6 +146,7 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
   Fusions f{std::vector<bool>(ops.size()),
             std::vector<std::optional<ConvInputParts>>(ops.size()),
             std::vector<const graph::RefineUpdate*>(ops.size()),
+            std::vector<std::pair<const graph::Zero*, const graph::Copy*>>(ops.size()),
             std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()),
             std::vector<bool>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
@@ -152,6 +181,12 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
                  then->in.c == 2 && !then->relu) {
         f.absorbed[j] = true;
         f.resample_after[i] = then;
+      }
+    } else if (const auto* corr = std::get_if<graph::LocalCorrelation>(&ops[i].op); corr && !f.update_first[i]) {
+      if (const auto start = step_start_before(ops, i, *corr, f)) {
+        f.absorbed[start->first] = f.absorbed[start->second] = true;
+        f.start_first[i] = {&std::get<graph::Zero>(ops[start->first].op),
+                            &std::get<graph::Copy>(ops[start->second].op)};
       }
     } else if (const auto* affine = std::get_if<graph::ChannelAffine<DeviceTensor>>(&ops[i].op)) {
       for (std::size_t k = i; k-- > 0;) {
@@ -207,6 +242,8 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       }
     } else if (f.update_first[i]) {
       record_op(r, std::get<graph::LocalCorrelation>(op), f.update_first[i]);
+    } else if (f.start_first[i].first) {
+      record_op(r, std::get<graph::LocalCorrelation>(op), *f.start_first[i].first, *f.start_first[i].second);
     } else if (f.affine_after[i]) {
       record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);
     } else if (f.resample_after[i]) {

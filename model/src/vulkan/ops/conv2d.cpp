@@ -74,7 +74,8 @@ WinogradConvParams winograd_conv_params(Recorder& r, const graph::Conv2d<DeviceT
 // F(4×4, 3×3) in one dispatch (winograd_conv.comp): the filters and tiles transformed as they
 // are loaded, the products transformed back with bias, addend and activation as they are
 // stored. It reads what the direct convolution reads (`others`: the filters, bias and addend
-// values besides the input) and writes what it writes.
+// values besides the input; the input from its parts where it reads them) and writes what it
+// writes.
 void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
                            const View& addend, long long others, const ConvInputParts* parts) {
   WinogradInput input;

@@ -41,6 +41,9 @@ void record_op(Recorder& r, const graph::LocalCorrelation& op);
 // The correlation with the previous refinement step's update applied first, in one dispatch
 // (`previous` nullptr: the correlation alone).
 void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::RefineUpdate* previous);
+// A scale's first correlation with the step input's first values (its hidden state zeroed, the
+// flow copied into it: `hidden`, `flow_copy`) in one dispatch.
+void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::Zero& hidden, const graph::Copy& flow_copy);
 // `then`: a resample (or copy) of the new flow into another tensor, written in the same dispatch
 // (or nullptr).
 void record_op(Recorder& r, const graph::RefineUpdate& op, const graph::Resample* then = nullptr);

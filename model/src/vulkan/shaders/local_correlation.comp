@@ -11,7 +11,9 @@
 // With APPLY_UPDATE it is also the end of the refinement's previous step (refine_update.comp's
 // arithmetic, in the same dispatch): the flow is the stored flow plus conv3's delta, written
 // back (and into the step input's flow channels) once every invocation of the block has read
-// it; the clamped hidden state goes into the step input's hidden channels.
+// it; the clamped hidden state goes into the step input's hidden channels. Without a previous
+// step (update_off < 0, a scale's first correlation) it starts the step input instead: the flow
+// as it is into its flow channels, zeros into its hidden ones.
 layout(local_size_x = 16, local_size_y = 10) in;
 layout(std430, binding = 0) readonly buffer F0 { VALUE f0[]; };
 layout(std430, binding = 1) readonly buffer F1 { VALUE f1[]; };
@@ -43,10 +45,13 @@ void main() {
       fx = flow[p.flow_off + pix];
       fy = flow[p.flow_off + plane + pix];
 #ifdef APPLY_UPDATE
-      fx = VALUE(float(fx) + float(update[p.update_off + pix]));
-      fy = VALUE(float(fy) + float(update[p.update_off + plane + pix]));
+      if (p.update_off >= 0) {
+        fx = VALUE(float(fx) + float(update[p.update_off + pix]));
+        fy = VALUE(float(fy) + float(update[p.update_off + plane + pix]));
+      }
       for (int c = j; c < 64; c += N) {
-        dst[p.hidden_off + c * plane + pix] = VALUE(clamp(float(update[p.update_off + (2 + c) * plane + pix]), -4.0, 4.0));
+        dst[p.hidden_off + c * plane + pix] =
+            p.update_off >= 0 ? VALUE(clamp(float(update[p.update_off + (2 + c) * plane + pix]), -4.0, 4.0)) : VALUE(0.0);
       }
 #endif
       const float px = float(x) + float(fx);
@@ -73,8 +78,10 @@ void main() {
 #ifdef APPLY_UPDATE
     // Every invocation of this pixel has read its flow (before the barrier).
     if (pix < plane && j == 0) {
-      flow[p.flow_off + pix] = fx;
-      flow[p.flow_off + plane + pix] = fy;
+      if (p.update_off >= 0) {
+        flow[p.flow_off + pix] = fx;
+        flow[p.flow_off + plane + pix] = fy;
+      }
       dst[p.flow_copy_off + pix] = fx;
       dst[p.flow_copy_off + plane + pix] = fy;
     }

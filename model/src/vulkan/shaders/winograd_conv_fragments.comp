@@ -84,7 +84,6 @@ void main() {
   const int row = id / 32;
 #endif
   const int t0 = int(gl_WorkGroupID.x) * F, o0 = int(gl_WorkGroupID.y) * F;
-  const int plane = p.h * p.w;
 
 #ifdef TENSOR_CORES
   SUMS acc[6];

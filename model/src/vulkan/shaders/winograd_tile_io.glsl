@@ -8,20 +8,20 @@
 #ifdef READS_INPUT_TILES
 #ifdef INPUT_IN_PARTS
 // Input channel ci at (y, x) where the concatenation's parts lie (winograd_conv_params.h): `src`
-// and the including shader's `src2`, each upsampled by 2^shift, through ReLU, scaled, as the
-// resamples that would have written the concatenated input compute it.
+// and the including shader's `src2`, each upsampled by 2^shift, through ReLU, scaled and rounded
+// to the stored type, as the resamples that would have written the concatenated input store it.
 float input_value(int ci, int y, int x) {
   float v;
   if (ci < p.part_c) {
     const int h = p.h >> p.shift, w = p.w >> p.shift;
     v = float(src[p.in_off + (ci * h + (y >> p.shift)) * w + (x >> p.shift)]);
     if ((p.relu_parts & 1) != 0) v = max(v, 0.0);
-    return v * p.scale;
+    return float(VALUE(v * p.scale));
   }
   const int h = p.h >> p.shift2, w = p.w >> p.shift2;
   v = float(src2[p.in2_off + ((ci - p.part_c) * h + (y >> p.shift2)) * w + (x >> p.shift2)]);
   if ((p.relu_parts & 2) != 0) v = max(v, 0.0);
-  return v * p.scale2;
+  return float(VALUE(v * p.scale2));
 }
 #else
 float input_value(int ci, int y, int x) { return float(src[p.in_off + (ci * p.h + y) * p.w + x]); }

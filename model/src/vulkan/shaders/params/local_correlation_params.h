@@ -6,8 +6,9 @@
 
 NEUFLOW_PUSH_CONSTANTS(LocalCorrelationParams)
   int h, w, channels, f0_off, f1_off, flow_off, out_off;
-  // local_correlation_update only: where conv3's output is, and where the step input's hidden
-  // state and flow channels are (in the output's buffer).
+  // local_correlation_update only: where conv3's output is (< 0: no previous step, the step
+  // input's first values), and where the step input's hidden state and flow channels are (in
+  // the output's buffer).
   int update_off, hidden_off, flow_copy_off;
 NEUFLOW_PUSH_CONSTANTS_END
 
