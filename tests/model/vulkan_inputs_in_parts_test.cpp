@@ -58,8 +58,7 @@ TEST(InputsInParts, OneDispatchWinogradConvolutionsReadAConcatenationsParts) {
   two.push_back(c.conv(5));
   two.push_back({6, graph::Zero{c.t.all(c.x)}});
   two.push_back(c.conv(7));
-  EXPECT_EQ(input_in_parts_at(two, c.t, 2, ConvAlgorithm::winograd_fused)->readers,
-            (std::vector<std::size_t>{4, 5}));
+  EXPECT_EQ(input_in_parts_at(two, c.t, 2, ConvAlgorithm::winograd_fused)->readers, (std::vector<std::size_t>{4, 5}));
 }
 
 TEST(InputsInParts, TheMemoryPlanKeepsEachPartsSourceUntilItsLastReader) {

@@ -197,7 +197,7 @@ TEST_F(VulkanWork, WinogradComputesFewerMultiplyAdds) {
   const double ratio = static_cast<double>(fused.multiply_adds()) / direct;
   std::printf("multiply-adds, Winograd over direct: %.3f\n", ratio);
   EXPECT_LE(ratio, kWinogradRatioBudget);
-  EXPECT_GT(multiply_adds_of(fused, {"winograd_conv"}), 0u);
+  EXPECT_GT(multiply_adds_of(fused, {"winograd_conv", "winograd_conv_parts"}), 0u);
   const auto split_commands = [](const DeviceWork& work) {
     return std::count_if(work.commands.begin(), work.commands.end(), [](const DeviceCommand& c) {
       return c.kernel == "winograd_input" || c.kernel == "winograd_gemm" || c.kernel == "winograd_output";
@@ -206,8 +206,9 @@ TEST_F(VulkanWork, WinogradComputesFewerMultiplyAdds) {
   EXPECT_EQ(split_commands(fused), 0);
   EXPECT_EQ(split_commands(split),
             3 * std::count_if(fused.commands.begin(), fused.commands.end(),
-                              [](const DeviceCommand& c) { return c.kernel == "winograd_conv"; }));
-  EXPECT_EQ(multiply_adds_of(split, {"winograd_gemm"}), multiply_adds_of(fused, {"winograd_conv"}));
+                              [](const DeviceCommand& c) { return c.kernel.starts_with("winograd_conv"); }));
+  EXPECT_EQ(multiply_adds_of(split, {"winograd_gemm"}),
+            multiply_adds_of(fused, {"winograd_conv", "winograd_conv_parts"}));
   EXPECT_EQ(split.multiply_adds(), fused.multiply_adds());
   // The fused form reads the merges' inputs (both frames' and the context's) and the upsampler's
   // where their parts lie; the split form writes them as concatenations first.
@@ -216,6 +217,7 @@ TEST_F(VulkanWork, WinogradComputesFewerMultiplyAdds) {
                          [](const DeviceCommand& c) { return c.stage == "merge_s8" && c.kernel == "resample"; });
   };
   EXPECT_EQ(merge_resamples(fused), 0);
+  EXPECT_EQ(test::dispatches_of(fused, "winograd_conv_parts"), 4) << "three merges and the upsampler's first layer";
   EXPECT_EQ(merge_resamples(split), 3);
   EXPECT_EQ(fused.copies + 1, split.copies);
   expect_within(fused, kWinograd);
@@ -245,8 +247,11 @@ TEST_F(VulkanWork, OnTensorCoresAWinogradLayerIsOneDispatch) {
   print("fp16 Winograd at 160x128, scalar", scalar);
   print("fp16 Winograd at 160x128, tensor cores (twin), fused", fused);
   print("fp16 Winograd at 160x128, tensor cores (twin), split", split);
-  const long layers = test::dispatches_of(fused, "winograd_conv_coopmat_twin");
-  EXPECT_EQ(layers, test::dispatches_of(scalar, "winograd_conv"));
+  const long layers = test::dispatches_of(fused, "winograd_conv_coopmat_twin") +
+                      test::dispatches_of(fused, "winograd_conv_parts_coopmat_twin");
+  EXPECT_EQ(test::dispatches_of(fused, "winograd_conv_parts_coopmat_twin"),
+            test::dispatches_of(scalar, "winograd_conv_parts"));
+  EXPECT_EQ(layers, test::dispatches_of(scalar, "winograd_conv") + test::dispatches_of(scalar, "winograd_conv_parts"));
   EXPECT_GT(layers, 0);
   EXPECT_EQ(fused.dispatches, scalar.dispatches);
   EXPECT_EQ(fused.barriers, scalar.barriers);

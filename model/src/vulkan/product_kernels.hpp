@@ -53,6 +53,8 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
     case Shader::matmul: return cores ? Shader::matmul_coopmat : Shader::matmul_coopmat_twin;
     case Shader::winograd_gemm: return cores ? Shader::winograd_gemm_coopmat : Shader::winograd_gemm_coopmat_twin;
     case Shader::winograd_conv: return cores ? Shader::winograd_conv_coopmat : Shader::winograd_conv_coopmat_twin;
+    case Shader::winograd_conv_parts:
+      return cores ? Shader::winograd_conv_parts_coopmat : Shader::winograd_conv_parts_coopmat_twin;
     default: throw std::logic_error(std::string("product_shader: ") + shader_name(scalar) + " is not a product");
   }
 }
@@ -60,7 +62,8 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
 // Whether a network whose products run on `kernels` records `shader`: every shader but the
 // other kernels' products.
 inline bool records(Shader shader, ProductKernels kernels) {
-  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::winograd_gemm, Shader::winograd_conv}) {
+  for (const Shader scalar :
+       {Shader::conv2d, Shader::matmul, Shader::winograd_gemm, Shader::winograd_conv, Shader::winograd_conv_parts}) {
     for (const ProductKernels k : {ProductKernels::scalar, ProductKernels::tensor_cores, ProductKernels::twin}) {
       if (product_shader(scalar, k) == shader) return k == kernels;
     }

@@ -81,9 +81,10 @@ void record_winograd_fused(Recorder& r, const graph::Conv2d<DeviceTensor>& op, c
   WinogradInput input;
   const WinogradConvParams p = winograd_conv_params(r, op, in, out, addend, parts, input);
   const long long points = 36LL * out.c * in.c;
-  r.dispatch<Shader::winograd_conv>({&r.weights(), input.first, out.buffer, addend.buffer, nullptr, input.second}, p,
-                                    {r.bytes(input.values + others), r.bytes(out.count()), points * p.tiles},
-                                    tiles(p.tiles, "a convolution", 32), tiles(out.c, "a convolution", 16));
+  r.record_dispatch(parts ? Shader::winograd_conv_parts : Shader::winograd_conv,
+                    {&r.weights(), input.first, out.buffer, addend.buffer, nullptr, input.second}, &p, sizeof p,
+                    {r.bytes(input.values + others), r.bytes(out.count()), points * p.tiles},
+                    {tiles(p.tiles, "a convolution", 32), tiles(out.c, "a convolution", 16), 1});
 }
 
 // F(4×4, 3×3) in one dispatch with the products on fragments (winograd_conv_fragments.comp, on
@@ -97,7 +98,7 @@ void record_winograd_fragments(Recorder& r, const graph::Conv2d<DeviceTensor>& o
   const WinogradConvParams p = winograd_conv_params(r, op, in, out, addend, parts, input);
   const long long filters = 36LL * p.filters_out * p.filters_in;  // fp16, as the fragments load them
   r.record_dispatch(
-      product_shader(Shader::winograd_conv, r.product_kernels()),
+      product_shader(parts ? Shader::winograd_conv_parts : Shader::winograd_conv, r.product_kernels()),
       {&r.weights(), input.first, out.buffer, addend.buffer, &r.device_weights().winograd_buffer, input.second}, &p,
       sizeof p, {r.bytes(input.values + others) + filters * 2, r.bytes(out.count()), 36LL * out.c * in.c * p.tiles},
       {tiles(p.tiles, "a convolution", 16), tiles(out.c, "a convolution", 16), 1});

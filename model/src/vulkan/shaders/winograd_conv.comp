@@ -20,11 +20,12 @@ layout(std430, binding = 0) readonly buffer Weights { VALUE u[]; };
 layout(std430, binding = 1) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
+#ifdef INPUT_IN_PARTS
 layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input's second part
+#endif
 #include "params/winograd_conv_params.h"
 #include "activate.glsl"
 #define READS_INPUT_TILES
-#define INPUT_IN_PARTS
 #define WRITES_OUTPUT_TILES
 #include "winograd_tile_io.glsl"
 

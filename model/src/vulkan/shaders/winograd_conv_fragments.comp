@@ -32,11 +32,12 @@ layout(std430, binding = 1) readonly buffer In { VALUE src[]; };
 layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 layout(std430, binding = 4) readonly buffer Filters { float16_t filters[]; };
+#ifdef INPUT_IN_PARTS
 layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input's second part
+#endif
 #include "params/winograd_conv_params.h"
 #include "activate.glsl"
 #define READS_INPUT_TILES
-#define INPUT_IN_PARTS
 #include "winograd_tile_io.glsl"
 
 const int F = 16;  // a fragment: 16×16, K 16; the workgroup's tiles, channels and K step

@@ -6,40 +6,48 @@
 #include "winograd_transforms.glsl"
 
 #ifdef READS_INPUT_TILES
-#ifdef INPUT_IN_PARTS
-// Input channel ci at (y, x) where the concatenation's parts lie (winograd_conv_params.h): `src`
-// and the including shader's `src2`, each upsampled by 2^shift, through ReLU, scaled and rounded
-// to the stored type, as the resamples that would have written the concatenated input store it.
-float input_value(int ci, int y, int x) {
-  float v;
-  if (ci < p.part_c) {
-    const int h = p.h >> p.shift, w = p.w >> p.shift;
-    v = float(src[p.in_off + (ci * h + (y >> p.shift)) * w + (x >> p.shift)]);
-    if ((p.relu_parts & 1) != 0) v = max(v, 0.0);
-    return float(VALUE(v * p.scale));
+// d[r][c] = BUF at row (y0 + r) >> SHIFT, column (x0 + c) >> SHIFT of the plane at BASE, W
+// values a row (the input, or a part of it stored at 1 / 2^SHIFT of its size); zeros outside the
+// input (padding 1), and everywhere where !inside.
+#define LOAD_INPUT_TILE(BUF, BASE, SHIFT, W)                                                                  \
+  for (int r = 0; r < 6; ++r) {                                                                               \
+    const int y = y0 + r;                                                                                     \
+    for (int c = 0; c < 6; ++c) {                                                                             \
+      const int x = x0 + c;                                                                                   \
+      d[r][c] = (inside && y >= 0 && y < p.h && x >= 0 && x < p.w) ? float(BUF[(BASE) + (y >> (SHIFT)) * (W) + \
+                                                                               (x >> (SHIFT))])               \
+                                                                     : 0.0;                                  \
+    }                                                                                                         \
   }
-  const int h = p.h >> p.shift2, w = p.w >> p.shift2;
-  v = float(src2[p.in2_off + ((ci - p.part_c) * h + (y >> p.shift2)) * w + (x >> p.shift2)]);
-  if ((p.relu_parts & 2) != 0) v = max(v, 0.0);
-  return float(VALUE(v * p.scale2));
-}
-#else
-float input_value(int ci, int y, int x) { return float(src[p.in_off + (ci * p.h + y) * p.w + x]); }
-#endif
 
 // Bᵀ d B of the 6×6 input tile d of channel ci around 4×4 output tile (ty, tx) (p.h × p.w
 // planes): zeros outside the input (padding 1), and everywhere where !inside. Point 6 i + j in
-// v[6 i + j].
+// v[6 i + j]. With INPUT_IN_PARTS, channel ci where the concatenation's parts lie
+// (winograd_conv_params.h): `src` or the including shader's `src2`, upsampled by 2^shift, through
+// ReLU, scaled and rounded to the stored type, as the resamples that would have written the
+// concatenated input store it; the part and its plane are worked out once a tile.
 void input_tile(int ci, int ty, int tx, bool inside, out float v[36]) {
   const int y0 = 4 * ty - 1, x0 = 4 * tx - 1;
   float d[6][6];
-  for (int r = 0; r < 6; ++r) {
-    const int y = y0 + r;
-    for (int c = 0; c < 6; ++c) {
-      const int x = x0 + c;
-      d[r][c] = (inside && y >= 0 && y < p.h && x >= 0 && x < p.w) ? input_value(ci, y, x) : 0.0;
+#ifdef INPUT_IN_PARTS
+  const bool second = ci >= p.part_c;
+  const int shift = second ? p.shift2 : p.shift;
+  const int w = p.w >> shift, plane = (p.h >> shift) * w;
+  if (second) {
+    LOAD_INPUT_TILE(src2, p.in2_off + (ci - p.part_c) * plane, shift, w)
+  } else {
+    LOAD_INPUT_TILE(src, p.in_off + ci * plane, shift, w)
+  }
+  const bool relu = (p.relu_parts & (second ? 2 : 1)) != 0;
+  const float scale = second ? p.scale2 : p.scale;
+  if (relu || scale != 1.0) {
+    for (int r = 0; r < 6; ++r) {
+      for (int c = 0; c < 6; ++c) d[r][c] = float(VALUE((relu ? max(d[r][c], 0.0) : d[r][c]) * scale));
     }
   }
+#else
+  LOAD_INPUT_TILE(src, p.in_off + ci * p.h * p.w, 0, p.w)
+#endif
   float cols[6][6];  // Bᵀ d: each column transformed
   for (int c = 0; c < 6; ++c) {
     float r[6];

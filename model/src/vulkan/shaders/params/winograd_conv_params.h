@@ -5,11 +5,11 @@
 // transformed at upload (DeviceWeights), [36][filters_out][filters_in] fp16 with both sides
 // padded with zeros to multiples of 16, so a fragment loads them straight from binding 4. Each
 // kernel ignores the other's fields.
-// The input may be read where a concatenation's parts lie instead of from the concatenated copy
-// (winograd_tile_io.glsl): channels 0 .. part_c - 1 from binding 1 at in_off, the rest from
-// binding 5 at in2_off, each part stored (h >> shift) × (w >> shift) and read nearest-neighbour
-// upsampled, through ReLU where relu_parts has its bit (1: the first part, 2: the second), then
-// scaled. A plain input: part_c = in_c, shift 0, no ReLU, scale 1.
+// The _parts variants (INPUT_IN_PARTS) read the input where a concatenation's parts lie instead
+// of from the concatenated copy (winograd_tile_io.glsl): channels 0 .. part_c - 1 from binding 1
+// at in_off, the rest from binding 5 at in2_off, each part stored (h >> shift) × (w >> shift)
+// and read nearest-neighbour upsampled, through ReLU where relu_parts has its bit (1: the first
+// part, 2: the second), then scaled. The others ignore these fields.
 #ifndef NEUFLOW_SHADER_WINOGRAD_CONV_PARAMS_H
 #define NEUFLOW_SHADER_WINOGRAD_CONV_PARAMS_H
 #include "activation.h"
