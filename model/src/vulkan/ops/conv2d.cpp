@@ -1,3 +1,5 @@
+#include <bit>
+
 #include "vulkan/ops/record_op.hpp"
 #include "vulkan/ops/winograd.hpp"
 
@@ -14,11 +16,7 @@ struct WinogradInput {
 };
 
 // log2 of a resample's factor (a power of two: ConvInputParts' condition).
-int factor_shift(int factor) {
-  int shift = 0;
-  while ((1 << shift) < factor) ++shift;
-  return shift;
-}
+int factor_shift(int factor) { return std::countr_zero(static_cast<unsigned>(factor)); }
 
 // The parameters of both one-dispatch forms: winograd_conv.comp reads the OIHW filters at w_off,
 // winograd_conv_fragments.comp the filters transformed at upload. The input from `parts` where
@@ -139,20 +137,26 @@ void record_winograd(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const V
                                       groups(static_cast<long>(out.c) * tile_count, kLocal));
 }
 
+// F(4×4, 3×3) in one dispatch on the kernels the network runs its products on, the input from
+// `parts` where given (nullptr: from op.in).
+void record_winograd_one_dispatch(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const ConvInputParts* parts) {
+  const View in = r.view(op.in), out = r.view(op.out);
+  const View addend = op.addend ? r.view(*op.addend) : View{};
+  const long long others = (op.weights->bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
+  if (r.product_kernels() != ProductKernels::scalar) {
+    record_winograd_fragments(r, op, in, out, addend, others, parts);
+  } else {
+    record_winograd_fused(r, op, in, out, addend, others + 9LL * in.c * out.c, parts);  // and the 3×3 filters
+  }
+}
+
 }  // namespace
 
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const ConvInputParts& parts) {
   if (!reads_input_in_parts(r.conv_algorithm(), op, r.tensors())) {
     throw std::logic_error("the Vulkan " + op.layer + " does not read its input in parts");
   }
-  const View in = r.view(op.in), out = r.view(op.out);
-  const View addend = op.addend ? r.view(*op.addend) : View{};
-  const long long others = (op.weights->bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
-  if (r.product_kernels() != ProductKernels::scalar) {
-    record_winograd_fragments(r, op, in, out, addend, others, &parts);
-  } else {
-    record_winograd_fused(r, op, in, out, addend, others + 9LL * in.c * out.c, &parts);
-  }
+  record_winograd_one_dispatch(r, op, &parts);
 }
 
 // Stride-1 3×3 convolutions by Winograd where takes_winograd() says so, fused or split as the
@@ -167,10 +171,8 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
   if (takes_winograd(r.conv_algorithm(), op, out.h, out.w)) {
     if (r.conv_algorithm() == ConvAlgorithm::winograd_split) {
       record_winograd(r, op, in, out, addend);
-    } else if (r.product_kernels() != ProductKernels::scalar) {
-      record_winograd_fragments(r, op, in, out, addend, others, nullptr);
     } else {
-      record_winograd_fused(r, op, in, out, addend, others + taps * out.c, nullptr);
+      record_winograd_one_dispatch(r, op, nullptr);
     }
     return;
   }
