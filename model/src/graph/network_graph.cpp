@@ -70,41 +70,36 @@ class Builder {
     }
   }
 
-  // One cross-attention layer on `source`, which holds both frames' tokens (frame 0's rows above
-  // frame 1's): each frame's tokens attend to the other's. Every op but the attention is
-  // token-wise, so it runs both frames at once. The tokens are projected once into q, k and v
-  // (qkv_proj, q already scaled by 1/sqrt(192)): each frame's queries meet the other frame's
-  // keys and values.
-  void attention_layer(const BasicAttentionLayerWeights<T>& w, const std::string& layer, TensorId source,
-                       TensorId out) {
-    const TensorId qkv = like(layer + ".qkv", 3 * kFeatureChannels, source);
-    linear(w.qkv_proj, layer + ".qkv_proj", all(source), all(qkv));
-    // The MLP's input is concat[source, LayerNorm1(merged)]; the source's half is copied beside
-    // the projection, which it does not depend on.
-    const TensorId mlp_in = like(layer + ".mlp_input", 2 * kFeatureChannels, source);
-    emit(Copy{all(source), all(mlp_in).channels(0, kFeatureChannels)});
-    const TensorId message = like(layer + ".message", kFeatureChannels, source);
+  // One cross-attention layer on the source in the first half of `mlp_in`, which holds both
+  // frames' tokens (frame 0's rows above frame 1's): each frame's tokens attend to the other's.
+  // Every op but the attention is token-wise, so it runs both frames at once. The tokens are
+  // projected once into q, k and v (qkv_proj, q already scaled by 1/sqrt(192)): each frame's
+  // queries meet the other frame's keys and values. The MLP's input is concat[source,
+  // LayerNorm1(merged)]: the source is written into its half by whatever produces it, never
+  // copied there.
+  void attention_layer(const BasicAttentionLayerWeights<T>& w, const std::string& layer, TensorId mlp_in, Slice out) {
+    const Slice source = all(mlp_in).channels(0, kFeatureChannels);
+    const TensorId qkv = like(layer + ".qkv", 3 * kFeatureChannels, mlp_in);
+    linear(w.qkv_proj, layer + ".qkv_proj", source, all(qkv));
+    const TensorId message = like(layer + ".message", kFeatureChannels, mlp_in);
     emit(Attention{all(qkv).channels(0, kFeatureChannels), all(qkv).channels(kFeatureChannels, kFeatureChannels),
                    all(qkv).channels(2 * kFeatureChannels, kFeatureChannels), all(message), scores(), block_rows_,
                    true});
-    const TensorId merged = like(layer + ".merge", kFeatureChannels, source);
+    const TensorId merged = like(layer + ".merge", kFeatureChannels, mlp_in);
     linear(w.merge, layer + ".merge", all(message), all(merged));
     emit(LayerNorm<T>{&w.norm1, layer + ".norm1", all(merged), all(mlp_in).channels(kFeatureChannels, kFeatureChannels),
                       std::nullopt});
-    const TensorId hidden = like(layer + ".mlp.0", 2 * kFeatureChannels, source);
+    const TensorId hidden = like(layer + ".mlp.0", 2 * kFeatureChannels, mlp_in);
     linear(w.mlp0, layer + ".mlp.0", all(mlp_in), all(hidden), Activation::gelu);
-    const TensorId mlp_out = like(layer + ".mlp.2", kFeatureChannels, source);
+    const TensorId mlp_out = like(layer + ".mlp.2", kFeatureChannels, mlp_in);
     linear(w.mlp2, layer + ".mlp.2", all(hidden), all(mlp_out));
-    emit(LayerNorm<T>{&w.norm2, layer + ".norm2", all(mlp_out), all(out), all(source)});
+    emit(LayerNorm<T>{&w.norm2, layer + ".norm2", all(mlp_out), out, source});
   }
 
-  // Both frames' `c` channels in one tensor of twice the rows, frame 0's above frame 1's.
-  TensorId stack_frames(std::string name, std::array<Slice, 2> frames) {
-    const TensorDesc& d = g_.tensors.at(frames[0].tensor);
-    const int h = d.h, w = d.w, c = frames[0].c;
-    const TensorId both = tensor(std::move(name), c, 2 * h, w);
-    for (int f = 0; f < 2; ++f) emit(CopyRows{frames[static_cast<std::size_t>(f)], all(both), 0, f * h, h});
-    return both;
+  // Both frames' channels into `both`, a tensor of twice the rows: frame 0's above frame 1's.
+  void stack_frames(std::array<Slice, 2> frames, Slice both) {
+    const int h = g_.tensors.at(frames[0].tensor).h;
+    for (int f = 0; f < 2; ++f) emit(CopyRows{frames[static_cast<std::size_t>(f)], both, 0, f * h, h});
   }
   void unstack_frames(TensorId both, std::array<Slice, 2> frames) {
     const int h = g_.tensors.at(frames[0].tensor).h;
@@ -251,11 +246,15 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
 
   // 1/16: two cross-attention layers on both frames' tokens in one tensor (the second reads the
   // first's outputs of both frames), then the attention's BatchNorm.
-  const TensorId sources = b.stack_frames("cross_attn_s16.input", {b.all(first.f16), b.all(second.f16)});
-  const TensorId state = b.like("cross_attn_s16.layers.0", kFeatureChannels, sources);
-  const TensorId attended = b.like("cross_attn_s16.layers.1", kFeatureChannels, sources);
-  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", sources, state);
-  b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", state, attended);
+  // Each layer's source lies in its MLP input's first half: the first layer's comes stacked
+  // there, the second's from the first layer's last LayerNorm.
+  const TensorId mlp_in0 = b.tensor("cross_attn_s16.layers.0.mlp_input", 2 * kFeatureChannels, 2 * h16, w16);
+  const TensorId mlp_in1 = b.like("cross_attn_s16.layers.1.mlp_input", 2 * kFeatureChannels, mlp_in0);
+  const TensorId attended = b.like("cross_attn_s16.layers.1", kFeatureChannels, mlp_in0);
+  b.stack_frames({b.all(first.f16), b.all(second.f16)}, b.all(mlp_in0).channels(0, kFeatureChannels));
+  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", mlp_in0,
+                    b.all(mlp_in1).channels(0, kFeatureChannels));
+  b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", mlp_in1, b.all(attended));
   b.emit(ChannelAffine<T>{&w.attention_norm_scale, &w.attention_norm_shift, "cross_attn_s16.norm", b.all(attended)});
   const TensorId att0 = b.tensor("cross_attn_s16.frame0", kFeatureChannels, h16, w16);
   const TensorId att1 = b.tensor("cross_attn_s16.frame1", kFeatureChannels, h16, w16);
