@@ -252,8 +252,7 @@ NetworkGraph<T> build_network_graph(const BasicNetworkWeights<T>& w, int height,
   const TensorId mlp_in1 = b.like("cross_attn_s16.layers.1.mlp_input", 2 * kFeatureChannels, mlp_in0);
   const TensorId attended = b.like("cross_attn_s16.layers.1", kFeatureChannels, mlp_in0);
   b.stack_frames({b.all(first.f16), b.all(second.f16)}, b.all(mlp_in0).channels(0, kFeatureChannels));
-  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", mlp_in0,
-                    b.all(mlp_in1).channels(0, kFeatureChannels));
+  b.attention_layer(w.attention[0], "cross_attn_s16.layers.0", mlp_in0, b.all(mlp_in1).channels(0, kFeatureChannels));
   b.attention_layer(w.attention[1], "cross_attn_s16.layers.1", mlp_in1, b.all(attended));
   b.emit(ChannelAffine<T>{&w.attention_norm_scale, &w.attention_norm_shift, "cross_attn_s16.norm", b.all(attended)});
   const TensorId att0 = b.tensor("cross_attn_s16.frame0", kFeatureChannels, h16, w16);

@@ -4,6 +4,7 @@
 #include <variant>
 
 #include "vulkan/ops/winograd.hpp"
+#include "vulkan/unstacked_output.hpp"
 
 namespace neuflow::model::vulkan {
 
@@ -13,6 +14,11 @@ graph::Accesses accesses_of(const graph::Op<DeviceTensor>& op) {
 
 bool mentions(const std::vector<graph::Slice>& slices, graph::TensorId tensor) {
   return std::any_of(slices.begin(), slices.end(), [&](const graph::Slice& s) { return s.tensor == tensor; });
+}
+
+bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
+  const graph::Accesses a = accesses_of(op);
+  return mentions(a.reads, tensor) || mentions(a.writes, tensor);
 }
 
 std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op) {
@@ -115,6 +121,8 @@ graph::LiveRanges planned_live_ranges(const graph::TensorTable& tensors, const g
   graph::LiveRanges ranges = graph::live_ranges<DeviceTensor>(tensors, {&encode, &flow});
   extend_live_ranges(ranges, encode, tensors, 0, conv);
   extend_live_ranges(ranges, flow, tensors, static_cast<int>(encode.size()), conv);
+  start_unstacked_frames_early(ranges, encode, tensors, 0);
+  start_unstacked_frames_early(ranges, flow, tensors, static_cast<int>(encode.size()));
   return ranges;
 }
 

@@ -23,10 +23,12 @@ struct ConvInputParts {
   std::optional<graph::Resample> second;
 };
 
-// What an op reads and writes; whether slices name a tensor; a copy or a resample as a
-// resample (a copy is one of factor 1), the form a concatenation's part takes.
+// What an op reads and writes; whether slices name a tensor; whether an op reads or writes a
+// tensor; a copy or a resample as a resample (a copy is one of factor 1), the form a
+// concatenation's part takes.
 graph::Accesses accesses_of(const graph::Op<DeviceTensor>& op);
 bool mentions(const std::vector<graph::Slice>& slices, graph::TensorId tensor);
+bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor);
 std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op);
 
 struct InputInParts {
@@ -43,7 +45,8 @@ std::optional<InputInParts> input_in_parts_at(const graph::OpList<DeviceTensor>&
                                               std::size_t i, ConvAlgorithm conv);
 
 // What the Vulkan memory plan follows: live_ranges() over the encode and flow passes, with each
-// read-in-parts source tensor living until its last reader.
+// read-in-parts source tensor living until its last reader and each unstacked frame's tensor
+// from its LayerNorm on (unstacked_output.hpp).
 graph::LiveRanges planned_live_ranges(const graph::TensorTable& tensors, const graph::OpList<DeviceTensor>& encode,
                                       const graph::OpList<DeviceTensor>& flow, ConvAlgorithm conv);
 

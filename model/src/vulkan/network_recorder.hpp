@@ -83,7 +83,11 @@ class VulkanNetwork::Recorder {
   }
 
   const Buffer& upload() const { return transfer_.upload; }
-  const Buffer& readback() const { return transfer_.readback; }
+  // Where the pass's flow goes for the host (Transfer::flow), and the tensor whose values were
+  // last written there (-1: none yet).
+  const Buffer& flow_out() const { return transfer_.flow; }
+  void handed_out(graph::TensorId tensor) { handed_out_ = tensor; }
+  graph::TensorId handed_out() const { return handed_out_; }
   const DeviceWork& work() const { return work_; }
   // Bytes of `values` tensor values in the pass's precision.
   long long bytes(long long values) const { return values * static_cast<long long>(net_.elem_); }
@@ -113,12 +117,13 @@ class VulkanNetwork::Recorder {
   }
 
   // Makes a copy into a host-visible buffer visible to the host once the fence has signalled.
-  void host_barrier() {
+  // What `stage` wrote (a copy, or a shader), visible to the host once the pass's fence signals.
+  void host_barrier(VkPipelineStageFlags stage = VK_PIPELINE_STAGE_TRANSFER_BIT) {
     VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-    b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    b.srcAccessMask =
+        stage == VK_PIPELINE_STAGE_TRANSFER_BIT ? VK_ACCESS_TRANSFER_WRITE_BIT : VK_ACCESS_SHADER_WRITE_BIT;
     b.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vkCmdPipelineBarrier(commands_, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr, 0,
-                         nullptr);
+    vkCmdPipelineBarrier(commands_, stage, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &b, 0, nullptr, 0, nullptr);
     ++work_.barriers;
   }
 
@@ -251,10 +256,11 @@ class VulkanNetwork::Recorder {
   int height() const { return net_.height_; }
   int width() const { return net_.width_; }
 
-  // Copies `v` to the start of the ring entry's read-back buffer, for the host once the pass ends.
+  // Copies `v` to the start of the observer's read-back buffer, for the host once the commands
+  // so far have run.
   void read_back(const View& v) {
     const VkDeviceSize e = net_.elem_;
-    copy_region(*v.buffer, transfer_.readback,
+    copy_region(*v.buffer, net_.observed_,
                 {static_cast<VkDeviceSize>(v.offset()) * e, 0, static_cast<VkDeviceSize>(v.count()) * e});
     host_barrier();
   }
@@ -268,7 +274,7 @@ class VulkanNetwork::Recorder {
     read_back(v);
     run();
     net_.staging_.resize(static_cast<std::size_t>(v.count()));
-    net_.load(transfer_.readback.mapped(), net_.staging_.size(), net_.staging_.data());
+    net_.load(net_.observed_.mapped(), net_.staging_.size(), net_.staging_.data());
     const float* planar = net_.staging_.data();
     const std::size_t plane = static_cast<std::size_t>(v.h) * v.w;
     nhwc_.resize(plane * v.c);
@@ -365,6 +371,7 @@ class VulkanNetwork::Recorder {
   bool worked_ = false;  // commands recorded since the last timestamp
   DeviceWork work_;
   std::size_t labelled_ = 0;  // commands before this one have their stage
+  graph::TensorId handed_out_ = -1;
   // What was written and read since the last barrier; after_unknown_: nothing is known of what
   // ran before (a recording's start), so the next command waits for all of it.
   std::vector<Span> written_, read_;

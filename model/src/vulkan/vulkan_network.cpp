@@ -224,16 +224,10 @@ void VulkanNetwork::fill_upload(const Transfer& t, const Frame* frame, const Ten
   store(staging_.data(), staging_.size(), t.upload.mapped());
 }
 
+// The convex upsampling wrote it as the caller takes it.
 void VulkanNetwork::read_flow(const Transfer& t, Tensor& out) {
   out.resize(height_, width_, 2);
-  const std::size_t hw = static_cast<std::size_t>(height_) * width_;
-  staging_.resize(2 * hw);
-  load(t.readback.mapped(), staging_.size(), staging_.data());
-  const float* planar = staging_.data();
-  for (std::size_t p = 0; p < hw; ++p) {
-    out.data[2 * p] = planar[p];
-    out.data[2 * p + 1] = planar[hw + p];
-  }
+  std::memcpy(out.data.data(), t.flow.mapped(), out.data.size() * sizeof(float));
 }
 
 // One recording per slot and layout: a session's frames keep one size and channel order.

@@ -119,8 +119,10 @@ class VulkanNetwork {
   };
   // What the host writes and reads while the device works: one per ring entry. The
   // synchronous calls use entry 0.
+  // `flow`: the pass's flow as the host hands it on ([height][width][2] fp32), written by the
+  // convex upsampling's dispatch.
   struct Transfer {
-    Buffer upload, readback;
+    Buffer upload, flow;
     VkFence fence = VK_NULL_HANDLE;
   };
   struct Started {
@@ -187,6 +189,7 @@ class VulkanNetwork {
   std::vector<StageTime> stage_times_;
   DeviceWork work_;
   VkCommandBuffer observed_commands_ = VK_NULL_HANDLE;
+  Buffer observed_;  // where an observer's tensors are read back, one at a time
 };
 
 }  // namespace neuflow::model::vulkan

@@ -16,6 +16,7 @@
 #include "vulkan/one_shot_commands.hpp"
 #include "vulkan/ops/record_op.hpp"
 #include "vulkan/ops/winograd.hpp"
+#include "vulkan/unstacked_output.hpp"
 #include "vulkan/vulkan_network.hpp"
 
 namespace neuflow::model::vulkan {
@@ -42,22 +43,21 @@ namespace {
 // - before all of these: a concatenation (one or two copies or resamples writing all of a
 //   transient tensor's channels) that only one-dispatch Winograd convolutions read, not
 //   recorded at all: they read its parts where they lie (ConvInputParts), where nothing writes
-//   the parts' memory until the last of them has run.
+//   the parts' memory until the last of them has run;
+// - likewise the cross-attention's stacked output (both frames' tokens in one tensor), where only
+//   the copies that unstack it read it: its LayerNorm writes each frame's tokens where those
+//   copies would put them (UnstackedOutput).
 struct Fusions {
   std::vector<bool> absorbed;
   std::vector<std::optional<ConvInputParts>> conv_parts;                       // of a convolution
   std::vector<const graph::RefineUpdate*> update_first;                        // of a correlation
   std::vector<std::pair<const graph::Zero*, const graph::Copy*>> start_first;  // of a correlation
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;         // of a LayerNorm
+  std::vector<std::optional<UnstackedOutput>> unstacked;                       // of a LayerNorm
   std::vector<bool> pyramid;                                                   // starts here
   std::vector<std::optional<graph::Resample>> concat_first;                    // of a resample
   std::vector<std::optional<graph::Resample>> resample_after;                  // of a RefineUpdate
 };
-
-bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor) {
-  const graph::Accesses a = accesses_of(op);
-  return mentions(a.reads, tensor) || mentions(a.writes, tensor);
-}
 
 // The resample after ops[i] that writes the channels right after its output's, with nothing
 // between them touching that tensor or writing ops[i]'s input.
@@ -104,6 +104,25 @@ void find_input_in_parts(const graph::OpList<DeviceTensor>& ops, const graph::Te
   for (const std::size_t reader : found->readers) f.conv_parts[reader] = found->parts;
 }
 
+// The stacked tensor that the LayerNorm ops[i] writes, where it writes each frame's tokens apart:
+// marks the copies that unstack it absorbed. As for the concatenations, the memory plan keeps the
+// frames' tensors apart from what the LayerNorm reads, and this checks it.
+void find_unstacked_output(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, std::size_t i,
+                           Recorder& r, Fusions& f) {
+  const auto found = unstacked_output_at(ops, tensors, i);
+  if (!found) return;
+  for (const graph::Slice& frame : found->frames) {
+    for (const graph::Slice& read : accesses_of(ops[i].op).reads) {
+      if (overlap(r.view(frame), r.view(read))) {
+        throw std::logic_error("the Vulkan memory plan overlaps " + tensors.at(frame.tensor).name + " with what " +
+                               graph::describe(ops[i].op) + " reads");
+      }
+    }
+  }
+  for (const std::size_t copy : found->copies) f.absorbed[copy] = true;
+  f.unstacked[i] = found;
+}
+
 // The step input's first values before a scale's first correlation ops[i]: the zeroed hidden
 // state and the flow's copy (their indices), where no other op since touches the step input or
 // the flow.
@@ -142,17 +161,30 @@ std::optional<std::array<const graph::AvgPool2x*, 3>> pyramid_at(const graph::Op
   return pools;
 }
 
+// Whether an op after ops[i] reads `tensor` on the device: the pass's Output does not (the host
+// takes what the convex upsampling hands it), nor an unobserved stage end.
+bool read_after(const graph::OpList<DeviceTensor>& ops, std::size_t i, graph::TensorId tensor, bool observing) {
+  for (std::size_t j = i + 1; j < ops.size(); ++j) {
+    if (std::holds_alternative<graph::Output>(ops[j].op)) continue;
+    if (!observing && std::holds_alternative<graph::StageEnd>(ops[j].op)) continue;
+    if (mentions(accesses_of(ops[j].op).reads, tensor)) return true;
+  }
+  return false;
+}
+
 Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, Recorder& r) {
   Fusions f{std::vector<bool>(ops.size()),
             std::vector<std::optional<ConvInputParts>>(ops.size()),
             std::vector<const graph::RefineUpdate*>(ops.size()),
             std::vector<std::pair<const graph::Zero*, const graph::Copy*>>(ops.size()),
             std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()),
+            std::vector<std::optional<UnstackedOutput>>(ops.size()),
             std::vector<bool>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (!f.absorbed[i]) find_input_in_parts(ops, tensors, i, r, f);
+    if (!f.absorbed[i]) find_unstacked_output(ops, tensors, i, r, f);
   }
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (f.absorbed[i]) continue;
@@ -244,14 +276,16 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LocalCorrelation>(op), f.update_first[i]);
     } else if (f.start_first[i].first) {
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.start_first[i].first, *f.start_first[i].second);
-    } else if (f.affine_after[i]) {
-      record_op(r, std::get<graph::LayerNorm<DeviceTensor>>(op), f.affine_after[i]);
+    } else if (const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&op)) {
+      record_op(r, *norm, f.affine_after[i], f.unstacked[i] ? &*f.unstacked[i] : nullptr);
     } else if (f.resample_after[i]) {
       record_op(r, std::get<graph::RefineUpdate>(op), &*f.resample_after[i]);
     } else if (f.conv_parts[i]) {
       record_op(r, std::get<graph::Conv2d<DeviceTensor>>(op), *f.conv_parts[i]);
     } else if (f.concat_first[i]) {
       record_op(r, *f.concat_first[i], std::get<graph::Resample>(op));
+    } else if (const auto* upsample = std::get_if<graph::ConvexUpsample>(&op)) {
+      record_op(r, *upsample, read_after(ops, i, upsample->out.tensor, r.observing()));
     } else {
       std::visit([&](const auto& o) { record_op(r, o); }, op);
     }
@@ -307,7 +341,7 @@ void VulkanNetwork::allocate_tensors() {
     return device_.create_buffer(values * elem_, memory, what + size);
   };
   // The largest range the passes zero, and the largest tensor an observer reads back.
-  std::size_t zeroed = 1, observed = 2 * hw;
+  std::size_t zeroed = 1, observed = 1;
   for (const auto* ops : {&graph_.encode, &graph_.flow}) {
     for (const auto& node : *ops) {
       if (const auto* z = std::get_if<graph::Zero>(&node.op)) {
@@ -338,9 +372,9 @@ void VulkanNetwork::allocate_tensors() {
   zeros_ = make(zeroed, "zeros");
   for (std::size_t e = 0; e < ring_.size(); ++e) {
     ring_[e].upload = make(3 * hw, "the frame upload", M::upload);
-    // Entry 0 also serves the observer, which reads whole stages back.
-    ring_[e].readback = make(e == 0 ? observed : 2 * hw, "the read-back buffer", M::readback);
+    ring_[e].flow = device_.create_buffer(2 * hw * sizeof(float), M::readback, "the flow's read-back buffer" + size);
   }
+  observed_ = make(observed, "the observer's read-back buffer", M::readback);
   for (std::size_t r = 0; r < plan_.region_size.size(); ++r) {
     regions_.push_back(make(plan_.region_size[r], "the network's memory region " + std::to_string(r)));
   }

@@ -7,6 +7,7 @@
 #include "vulkan/device_weights.hpp"
 #include "vulkan/inputs_in_parts.hpp"
 #include "vulkan/network_recorder.hpp"
+#include "vulkan/unstacked_output.hpp"
 
 namespace neuflow::model::vulkan {
 
@@ -25,9 +26,10 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const ConvInputParts& parts);
 void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::Attention& op);
-// `then`: a folded BatchNorm applied to the output in the same dispatch (or nullptr).
+// `then`: a folded BatchNorm applied to the output in the same dispatch (or nullptr);
+// `unstacked`: both frames' tokens written apart, where the copies that would unstack them go.
 void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op,
-               const graph::ChannelAffine<DeviceTensor>* then = nullptr);
+               const graph::ChannelAffine<DeviceTensor>* then = nullptr, const UnstackedOutput* unstacked = nullptr);
 void record_op(Recorder& r, const graph::ChannelAffine<DeviceTensor>& op);
 void record_op(Recorder& r, const graph::GlobalMatching& op);
 void record_op(Recorder& r, const graph::Resample& op);
@@ -47,7 +49,9 @@ void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::Zero
 // `then`: a resample (or copy) of the new flow into another tensor, written in the same dispatch
 // (or nullptr).
 void record_op(Recorder& r, const graph::RefineUpdate& op, const graph::Resample* then = nullptr);
-void record_op(Recorder& r, const graph::ConvexUpsample& op);
+// The flow into the ring entry's read-back buffer as the host takes it, and with `planar` (where
+// an op other than Output reads the output tensor) into that tensor as well.
+void record_op(Recorder& r, const graph::ConvexUpsample& op, bool planar = true);
 void record_op(Recorder& r, const graph::Output& op);
 void record_op(Recorder& r, const graph::StageEnd& op);
 

@@ -2,12 +2,15 @@
 #extension GL_GOOGLE_include_directive : require
 #include "precision.glsl"
 // Convex upsampling ×8: output pixel (8y + a, 8x + b) = 8 · Σ_k softmax_k(mask[k·64 + a·8 + b])
-// · flow8[3×3 neighbour k of (y, x)], zero outside. Planar mask [576][h8·w8], flow8 [2][h8·w8],
-// output [2][8h8][8w8].
+// · flow8[3×3 neighbour k of (y, x)], zero outside. Planar mask [576][h8·w8], flow8 [2][h8·w8].
+// The flow leaves as the host hands it on: interleaved [8h8][8w8][2] fp32, into the ring entry's
+// read-back buffer, whatever the tensors' precision (nothing converts it on the host). An
+// observed pass also gets it planar [2][8h8][8w8] in the tensors' precision, the stage's tensor.
 #include "common.glsl"
 layout(std430, binding = 0) readonly buffer Mask { VALUE mask[]; };
 layout(std430, binding = 1) readonly buffer Flow8 { VALUE flow8[]; };
-layout(std430, binding = 2) writeonly buffer Out { VALUE dst[]; };
+layout(std430, binding = 2) writeonly buffer FlowOut { float flow_out[]; };
+layout(std430, binding = 3) writeonly buffer Planar { VALUE planar[]; };
 #include "params/convex_upsample_params.h"
 
 void main() {
@@ -33,7 +36,12 @@ void main() {
         v += e * float(flow8[plane8 + yy * p.w8 + xx]);
       }
     }
-    dst[i] = VALUE(8.0 * u / sum);
-    dst[H * W + i] = VALUE(8.0 * v / sum);
+    const vec2 f = vec2(8.0 * u / sum, 8.0 * v / sum);
+    flow_out[2 * i] = f.x;
+    flow_out[2 * i + 1] = f.y;
+    if (p.planar != 0) {
+      planar[i] = VALUE(f.x);
+      planar[H * W + i] = VALUE(f.y);
+    }
   }
 }

@@ -5,6 +5,7 @@
 
 NEUFLOW_PUSH_CONSTANTS(ConvexUpsampleParams)
   int h8, w8;
+  int planar;  // != 0: the flow also into the planar tensor (binding 3), for a stage observer
 NEUFLOW_PUSH_CONSTANTS_END
 
 #endif
