@@ -102,7 +102,7 @@ void NetworkPlan::choose_layouts() {
   std::vector<int> readers(n, 0);
   for (const auto* pass : {&graph_.encode, &graph_.flow}) {
     for (const auto& node : *pass) {
-      const graph::Accesses a = std::visit([](const auto& o) { return o.accesses(); }, node.op);
+      const graph::Accesses a = graph::accesses_of(node.op);
       for (const graph::Slice& s : a.reads) ++readers[static_cast<std::size_t>(s.tensor)];
     }
   }

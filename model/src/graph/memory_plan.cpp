@@ -67,7 +67,7 @@ LiveRanges live_ranges(const TensorTable& tensors, const std::vector<const OpLis
     std::fill(open.begin(), open.end(), false);
     for (const Node<T>& node : *pass) {
       // Reads first: an op that reads and writes a tensor continues its range.
-      const Accesses a = std::visit([](const auto& o) { return o.accesses(); }, node.op);
+      const Accesses a = accesses_of(node.op);
       for (const Slice& r : a.reads) {
         const auto i = static_cast<std::size_t>(r.tensor);
         if (!planned(tensors.at(r.tensor))) continue;

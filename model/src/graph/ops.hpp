@@ -187,4 +187,10 @@ struct Node {
 template <typename T>
 using OpList = std::vector<Node<T>>;
 
+// What `op` reads and writes, whichever op it is.
+template <typename T>
+Accesses accesses_of(const Op<T>& op) {
+  return std::visit([](const auto& o) { return o.accesses(); }, op);
+}
+
 }  // namespace neuflow::model::graph

@@ -48,7 +48,7 @@ class Checker {
 
   void check(const Op<T>& op) {
     op_ = &op;
-    const Accesses a = std::visit([](const auto& o) { return o.accesses(); }, op);
+    const Accesses a = accesses_of(op);
     for (const auto* slices : {&a.reads, &a.writes}) {
       for (const Slice& s : *slices) inside(s);
     }

@@ -8,10 +8,6 @@
 
 namespace neuflow::model::vulkan {
 
-graph::Accesses accesses_of(const graph::Op<DeviceTensor>& op) {
-  return std::visit([](const auto& o) { return o.accesses(); }, op);
-}
-
 bool mentions(const std::vector<graph::Slice>& slices, graph::TensorId tensor) {
   return std::any_of(slices.begin(), slices.end(), [&](const graph::Slice& s) { return s.tensor == tensor; });
 }

@@ -33,8 +33,8 @@ std::optional<UnstackedOutput> unstacked_output_at(const graph::OpList<DeviceTen
     first = false;
     if (folded) continue;  // recorded in the LayerNorm's dispatch
     const auto* copy = std::get_if<graph::CopyRows>(&ops[k].op);
-    if (!copy || copy->in.tensor != stacked || !whole(copy->in, tensors) || copy->rows != rows ||
-        copy->out_row != 0 || copy->out.tensor == stacked || !whole(copy->out, tensors)) {
+    if (!copy || copy->in.tensor != stacked || !whole(copy->in, tensors) || copy->rows != rows || copy->out_row != 0 ||
+        copy->out.tensor == stacked || !whole(copy->out, tensors)) {
       return std::nullopt;
     }
     const graph::TensorDesc& to = tensors.at(copy->out.tensor);

@@ -16,7 +16,7 @@
 namespace neuflow::model::vulkan {
 
 struct UnstackedOutput {
-  std::array<std::size_t, 2> copies;  // the CopyRows, not recorded: frame 0's, frame 1's
+  std::array<std::size_t, 2> copies;   // the CopyRows, not recorded: frame 0's, frame 1's
   std::array<graph::Slice, 2> frames;  // where each frame's tokens go, whole tensors
 };
 
