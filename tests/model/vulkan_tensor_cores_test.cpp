@@ -67,8 +67,8 @@ class VulkanTensorCores : public ::testing::Test {
 
 std::shared_ptr<const FlowModel> VulkanTensorCores::model_;
 
-const std::set<std::string> kScalarProducts{"conv2d", "matmul", "winograd_gemm", "winograd_conv",
-                                            "winograd_conv_parts"};
+const std::set<std::string> kScalarProducts{
+    "conv2d", "matmul", "winograd_gemm", "winograd_conv", "winograd_conv_parts", "conv2d_convex"};
 
 // The kernels of a streamed frame's commands, each once.
 std::set<std::string> kernels_of(const DeviceWork& work) {
@@ -127,6 +127,7 @@ TEST_F(VulkanTensorCores, TheTwinRunsEveryProductOfTheNetwork) {
     const auto names = kernels_of(twin);
     EXPECT_TRUE(names.contains("conv2d_coopmat_twin")) << conv;
     EXPECT_TRUE(names.contains("matmul_coopmat_twin")) << conv;
+    EXPECT_TRUE(names.contains("conv2d_convex_coopmat_twin")) << conv;
     EXPECT_EQ(names.contains("winograd_gemm_coopmat_twin"), std::string(conv) == "winograd-split") << conv;
     EXPECT_EQ(names.contains("winograd_conv_coopmat_twin"), std::string(conv) == "winograd") << conv;
   }

@@ -1,9 +1,12 @@
 #include "vulkan/device_weights.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <stdexcept>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "vulkan/half_float.hpp"
@@ -68,6 +71,27 @@ struct Packer {
   std::map<int, int> winograd_filters;
 };
 
+// upsample_conv3's filters and bias reordered as DeviceWeights::convex_mask describes.
+std::pair<std::vector<float>, std::vector<float>> convex_mask_rows(const ConvWeights& conv) {
+  constexpr int kGroups = DeviceWeights::kConvexTileRows / 9, kSubpixels = 64;
+  const auto in = static_cast<std::size_t>(conv.in_channels);  // 1×1
+  if (conv.out_channels != 9 * kSubpixels || conv.kernel_h != 1 || conv.kernel_w != 1) {
+    throw std::logic_error("the upsampler's mask convolution is not 1x1 with 576 outputs");
+  }
+  std::vector<float> weight(static_cast<std::size_t>(DeviceWeights::kConvexRows) * in, 0.f);
+  std::vector<float> bias(DeviceWeights::kConvexRows, 0.f);
+  for (int row = 0; row < DeviceWeights::kConvexRows; ++row) {
+    const int tile = row / DeviceWeights::kConvexTileRows, r = row % DeviceWeights::kConvexTileRows;
+    const int g = r / 9, k = r % 9, s = tile * kGroups + g;
+    if (g >= kGroups || s >= kSubpixels) continue;
+    const std::size_t from = static_cast<std::size_t>(k) * kSubpixels + static_cast<std::size_t>(s);
+    std::copy_n(conv.weight.begin() + static_cast<std::ptrdiff_t>(from * in), in,
+                weight.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(row) * in));
+    if (!conv.bias.empty()) bias[static_cast<std::size_t>(row)] = conv.bias[from];
+  }
+  return {std::move(weight), std::move(bias)};
+}
+
 // `values` in a device buffer of their own, in the tensors' precision.
 Buffer upload_values(VulkanDevice& device, const std::vector<float>& values, bool fp16, const std::string& what) {
   const std::size_t bytes = std::max<std::size_t>(values.size(), 1) * (fp16 ? 2 : 4);
@@ -95,6 +119,12 @@ std::shared_ptr<const DeviceWeights> upload(const std::shared_ptr<const FlowMode
   Packer p;
   p.winograd = winograd;
   map_weights(model->weights(), p, *d);
+  const ConvWeights& mask = model->weights().upsample_conv3;
+  const auto [weight, bias] = convex_mask_rows(mask);
+  d->convex_mask = d->upsample_conv3;
+  d->convex_mask.out_channels = DeviceWeights::kConvexRows;
+  d->convex_mask.weight = DeviceTensor{p.weights.add(weight)};
+  d->convex_mask.bias = DeviceTensor{p.weights.add(bias)};
   d->buffer = upload_values(*device, p.weights.data, fp16, "the model's weights");
   d->winograd_filters = std::move(p.winograd_filters);
   d->winograd_buffer = upload_values(*device, p.filters.data, fp16, "the model's Winograd filters");

@@ -38,6 +38,14 @@ struct DeviceWeights : BasicNetworkWeights<DeviceTensor> {
   std::map<int, int> winograd_filters;
   Buffer winograd_buffer;
 
+  // The upsampler's mask convolution (upsample_conv3, 1×1, 576 outputs) with its output rows
+  // reordered for convex_upsample_tile.glsl: in tiles of kConvexTileRows rows, tile t holds the
+  // 9 neighbours' logits of subpixels 7t .. 7t + 6, row g·9 + k from output channel k·64 + 7t + g;
+  // the tiles' last rows (and the last tile's past subpixel 63) zero.
+  static constexpr int kConvexTileRows = 64;
+  static constexpr int kConvexRows = 640;  // 10 tiles for the 64 subpixels
+  DeviceConv convex_mask;
+
   // The transformed filters of `conv`, or -1 where it has none.
   int winograd_filters_of(const DeviceConv& conv) const {
     const auto it = winograd_filters.find(conv.weight.offset);

@@ -147,6 +147,14 @@ class VulkanNetwork::Recorder {
                     {tiles(n, what, tile.columns()), tiles(m, what, tile.rows()), batches}, tile);
   }
 
+  // The same in `tile`, whatever the grid: a product whose epilogue needs that tile.
+  template <Shader S>
+  void product_in_tile(std::array<const Buffer*, kShaderBindings> bindings, const typename ShaderParams<S>::type& push,
+                       const Work& work, long m, long n, const char* what, GemmTile tile) {
+    record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work,
+                    {tiles(n, what, tile.columns()), tiles(m, what, tile.rows()), 1}, tile);
+  }
+
   // `tile`: a product's (its kernel's specialization); other shaders have none.
   void record_dispatch(Shader shader, std::array<const Buffer*, kShaderBindings> bindings, const void* push,
                        std::size_t bytes, const Work& work, std::array<uint32_t, 3> grid, GemmTile tile = kGemmTile64) {

@@ -43,13 +43,14 @@ inline ProductKernels product_kernels_for(const GpuDevice& device, bool fp16) {
   return want == "twin" ? ProductKernels::twin : ProductKernels::tensor_cores;
 }
 
-// The shader that computes the product `scalar` (conv2d, matmul, winograd_gemm or the fused
-// winograd_conv) with `kernels`.
+// The shader that computes the product `scalar` (conv2d, matmul, winograd_gemm, the fused
+// winograd_conv or conv2d_convex) with `kernels`.
 inline Shader product_shader(Shader scalar, ProductKernels kernels) {
   if (kernels == ProductKernels::scalar) return scalar;
   const bool cores = kernels == ProductKernels::tensor_cores;
   switch (scalar) {
     case Shader::conv2d: return cores ? Shader::conv2d_coopmat : Shader::conv2d_coopmat_twin;
+    case Shader::conv2d_convex: return cores ? Shader::conv2d_convex_coopmat : Shader::conv2d_convex_coopmat_twin;
     case Shader::matmul: return cores ? Shader::matmul_coopmat : Shader::matmul_coopmat_twin;
     case Shader::winograd_gemm: return cores ? Shader::winograd_gemm_coopmat : Shader::winograd_gemm_coopmat_twin;
     case Shader::winograd_conv: return cores ? Shader::winograd_conv_coopmat : Shader::winograd_conv_coopmat_twin;
@@ -62,8 +63,8 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
 // Whether a network whose products run on `kernels` records `shader`: every shader but the
 // other kernels' products.
 inline bool records(Shader shader, ProductKernels kernels) {
-  for (const Shader scalar :
-       {Shader::conv2d, Shader::matmul, Shader::winograd_gemm, Shader::winograd_conv, Shader::winograd_conv_parts}) {
+  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::winograd_gemm, Shader::winograd_conv,
+                              Shader::winograd_conv_parts, Shader::conv2d_convex}) {
     for (const ProductKernels k : {ProductKernels::scalar, ProductKernels::tensor_cores, ProductKernels::twin}) {
       if (product_shader(scalar, k) == shader) return k == kernels;
     }

@@ -46,7 +46,9 @@ namespace {
 //   the parts' memory until the last of them has run;
 // - likewise the cross-attention's stacked output (both frames' tokens in one tensor), where only
 //   the copies that unstack it read it: its LayerNorm writes each frame's tokens where those
-//   copies would put them (UnstackedOutput).
+//   copies would put them (UnstackedOutput);
+// - the convex upsampling, as the epilogue of the 1×1 convolution just before it that computes
+//   its mask (unobserved, nothing else reading the mask): the mask is never written.
 struct Fusions {
   std::vector<bool> absorbed;
   std::vector<std::optional<ConvInputParts>> conv_parts;                       // of a convolution
@@ -54,6 +56,7 @@ struct Fusions {
   std::vector<std::pair<const graph::Zero*, const graph::Copy*>> start_first;  // of a correlation
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;         // of a LayerNorm
   std::vector<std::optional<UnstackedOutput>> unstacked;                       // of a LayerNorm
+  std::vector<const graph::ConvexUpsample*> convex_after;                      // of a Conv2d
   std::vector<bool> pyramid;                                                   // starts here
   std::vector<std::optional<graph::Resample>> concat_first;                    // of a resample
   std::vector<std::optional<graph::Resample>> resample_after;                  // of a RefineUpdate
@@ -179,6 +182,7 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
             std::vector<std::pair<const graph::Zero*, const graph::Copy*>>(ops.size()),
             std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()),
             std::vector<std::optional<UnstackedOutput>>(ops.size()),
+            std::vector<const graph::ConvexUpsample*>(ops.size()),
             std::vector<bool>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size())};
@@ -219,6 +223,14 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
         f.absorbed[start->first] = f.absorbed[start->second] = true;
         f.start_first[i] = {&std::get<graph::Zero>(ops[start->first].op),
                             &std::get<graph::Copy>(ops[start->second].op)};
+      }
+    } else if (const auto* conv = std::get_if<graph::Conv2d<DeviceTensor>>(&ops[i].op);
+               conv && conv->weights == &r.device_weights().upsample_conv3 && !r.observing() && i + 1 < ops.size()) {
+      const auto* upsample = std::get_if<graph::ConvexUpsample>(&ops[i + 1].op);
+      if (upsample && !f.absorbed[i + 1] && upsample->mask.tensor == conv->out.tensor && upsample->mask.channel == 0 &&
+          upsample->mask.c == tensors.at(conv->out.tensor).c && !read_after(ops, i + 1, conv->out.tensor, false)) {
+        f.absorbed[i + 1] = true;
+        f.convex_after[i] = upsample;
       }
     } else if (const auto* affine = std::get_if<graph::ChannelAffine<DeviceTensor>>(&ops[i].op)) {
       for (std::size_t k = i; k-- > 0;) {
@@ -280,6 +292,8 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, *norm, f.affine_after[i], f.unstacked[i] ? &*f.unstacked[i] : nullptr);
     } else if (f.resample_after[i]) {
       record_op(r, std::get<graph::RefineUpdate>(op), &*f.resample_after[i]);
+    } else if (f.convex_after[i]) {
+      record_op(r, std::get<graph::Conv2d<DeviceTensor>>(op), *f.convex_after[i]);
     } else if (f.conv_parts[i]) {
       record_op(r, std::get<graph::Conv2d<DeviceTensor>>(op), *f.conv_parts[i]);
     } else if (f.concat_first[i]) {

@@ -16,4 +16,42 @@ void record_op(Recorder& r, const graph::ConvexUpsample& op, bool planar) {
   r.handed_out(op.out.tensor);
 }
 
+// The mask's product in 64×64 tiles of its reordered rows (DeviceWeights::convex_mask), each
+// tile's sums then upsampling its 7 subpixels of 64 pixels (convex_upsample_tile.glsl).
+void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& mask, const graph::ConvexUpsample& op) {
+  const DeviceConv& w = r.device_weights().convex_mask;
+  const View in = r.view(mask.in), flow = r.view(op.flow), out = r.view(op.out);
+  require_whole(flow, "convex upsampling");
+  require_whole(out, "convex upsampling");
+  if (mask.weights != &r.device_weights().upsample_conv3 || mask.stride != 1 || mask.pad != 0 ||
+      mask.act != Activation::none || mask.addend || in.h != flow.h || in.w != flow.w) {
+    throw std::logic_error("the Vulkan convex upsampling computes the mask of upsample_conv3 only, not of " +
+                           mask.layer);
+  }
+  const Conv2dParams p{in.c,
+                       in.h,
+                       in.w,
+                       in.offset(),
+                       w.out_channels,
+                       flow.h,
+                       flow.w,
+                       -1,
+                       1,
+                       1,
+                       0,
+                       activation_code(Activation::none),
+                       w.weight.offset,
+                       w.bias.offset,
+                       flow.offset(),
+                       1.f};
+  const long plane = static_cast<long>(flow.h) * flow.w;
+  const long long mask_values = static_cast<long long>(mask.weights->out_channels) * plane;
+  const long long read = in.count() + flow.count() + static_cast<long long>(mask.weights->out_channels) * (in.c + 1);
+  const long long written = static_cast<long long>(sizeof(float)) * out.count();
+  r.product_in_tile<Shader::conv2d_convex>({&r.weights(), in.buffer, &r.flow_out(), flow.buffer}, p,
+                                           {r.bytes(read), written, mask_values * in.c + 9LL * out.count()},
+                                           w.out_channels, plane, "the upsampler's mask", kGemmTile64);
+  r.handed_out(op.out.tensor);
+}
+
 }  // namespace neuflow::model::vulkan

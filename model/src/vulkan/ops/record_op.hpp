@@ -52,6 +52,9 @@ void record_op(Recorder& r, const graph::RefineUpdate& op, const graph::Resample
 // The flow into the ring entry's read-back buffer as the host takes it, and with `planar` (where
 // an op other than Output reads the output tensor) into that tensor as well.
 void record_op(Recorder& r, const graph::ConvexUpsample& op, bool planar = true);
+// The convex upsampling as the epilogue of the 1×1 convolution that computes its mask (`mask`,
+// upsample_conv3), the mask never written: the flow into the read-back buffer only.
+void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& mask, const graph::ConvexUpsample& op);
 void record_op(Recorder& r, const graph::Output& op);
 void record_op(Recorder& r, const graph::StageEnd& op);
 

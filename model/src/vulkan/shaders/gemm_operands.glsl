@@ -117,6 +117,11 @@ float gemm_b(GemmColumn col, GemmCursor c) {
 #endif
 }
 
+#ifdef CONVEX_UPSAMPLE
+#define PRODUCT_STORE convex_store  // convex_upsample_tile.glsl
+#else
+#define PRODUCT_STORE gemm_store
+
 // Writes C[m][n] from its sum of products, with what the product fuses (scale, bias, addend,
 // activation); nothing outside the matrix.
 void gemm_store(int m, int n, float sum) {
@@ -134,3 +139,4 @@ void gemm_store(int m, int n, float sum) {
   c_data[p.c_off + m * p.c_rs + n * p.c_cs] = VALUE(activate(v, p.act));
 #endif
 }
+#endif

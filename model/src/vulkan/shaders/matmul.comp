@@ -18,11 +18,14 @@ layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
 #ifdef WINOGRAD_GEMM
 layout(std430, binding = 1) readonly buffer BufB { float b_data[]; };
 layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };
+#elif defined(CONVEX_UPSAMPLE)
+layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
+layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };  // the flow for the host
 #else
 layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
 layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
 #endif
-layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend
+layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend (the 1/8 flow)
 
 #ifdef IMPLICIT_CONV
 #include "params/conv2d_params.h"
@@ -52,6 +55,9 @@ const int BM = 16 * TM, BN = 16 * TN, BK = 16;
 // put them in one or two.
 shared STAGED tile_a[BK][BM + PAD];
 shared STAGED tile_b[BK][BN];
+#ifdef CONVEX_UPSAMPLE
+#include "convex_upsample_tile.glsl"
+#endif
 
 void main() {
   const int tx = int(gl_LocalInvocationID.x), ty = int(gl_LocalInvocationID.y);
@@ -114,5 +120,9 @@ void main() {
   }
 
   for (int i = 0; i < TM; ++i)
-    for (int j = 0; j < TN; ++j) gemm_store(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+    for (int j = 0; j < TN; ++j) PRODUCT_STORE(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+#ifdef CONVEX_UPSAMPLE
+  barrier();
+  convex_upsample_tile(tid, 256);
+#endif
 }

@@ -34,11 +34,14 @@ layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
 #ifdef WINOGRAD_GEMM
 layout(std430, binding = 1) readonly buffer BufB { float b_data[]; };
 layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };
+#elif defined(CONVEX_UPSAMPLE)
+layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
+layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };  // the flow for the host
 #else
 layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
 layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
 #endif
-layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend
+layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend (the 1/8 flow)
 
 #ifdef IMPLICIT_CONV
 #include "params/conv2d_params.h"
@@ -65,6 +68,9 @@ const int SA = BK + 8, SB = BN + 8, SC = F + 4;
 shared float16_t tile_a[BM * SA];  // [m][k]
 shared float16_t tile_b[BK * SB];  // [k][n]
 shared float sums[WARPS * F * SC];  // one fragment's sums per subgroup, on their way out
+#ifdef CONVEX_UPSAMPLE
+#include "convex_upsample_tile.glsl"
+#endif
 
 #ifdef TENSOR_CORES
 #define OPERAND fcoopmatNV<16, gl_ScopeSubgroup, F, F>
@@ -153,8 +159,11 @@ void main() {
       barrier();
       for (int q = 0; q < 8; ++q) {
         const int r = lane / 16 + 2 * q, c = lane % 16;
-        gemm_store(row0 + out_row + F * i + r, col0 + out_col + F * j + c, sums[(tid / 32) * F * SC + r * SC + c]);
+        PRODUCT_STORE(row0 + out_row + F * i + r, col0 + out_col + F * j + c, sums[(tid / 32) * F * SC + r * SC + c]);
       }
       barrier();
     }
+#ifdef CONVEX_UPSAMPLE
+  convex_upsample_tile(tid, INVOCATIONS);
+#endif
 }
