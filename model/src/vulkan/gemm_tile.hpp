@@ -18,8 +18,8 @@ namespace neuflow::model::vulkan {
 
 struct GemmTile {
   int tm = 4, tn = 4;  // outputs per invocation along M (rows of C) and N (its columns)
-  int rows() const { return 16 * tm; }
-  int columns() const { return 16 * tn; }
+  constexpr int rows() const { return 16 * tm; }
+  constexpr int columns() const { return 16 * tn; }
   // matmul_fragments.comp's workgroup: subgroups of 32, 2 across the tile's columns and 4 down
   // its rows for 128×128 (2×4 fragments each), else 2 (2×2 fragments each at 64×64, one at 32×32).
   int fragment_invocations() const { return rows() >= 128 ? 256 : 128; }

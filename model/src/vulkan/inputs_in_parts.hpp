@@ -23,9 +23,9 @@ struct ConvInputParts {
   std::optional<graph::Resample> second;
 };
 
+using graph::accesses_of;
 // Whether slices name a tensor; whether an op reads or writes a tensor; a copy or a resample as
 // a resample (a copy is one of factor 1), the form a concatenation's part takes.
-using graph::accesses_of;
 bool mentions(const std::vector<graph::Slice>& slices, graph::TensorId tensor);
 bool touches(const graph::Op<DeviceTensor>& op, graph::TensorId tensor);
 std::optional<graph::Resample> as_resample(const graph::Op<DeviceTensor>& op);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -116,7 +117,6 @@ class VulkanNetwork::Recorder {
     net_.device_.submit_and_wait(commands_, transfer_.fence);
   }
 
-  // Makes a copy into a host-visible buffer visible to the host once the fence has signalled.
   // What `stage` wrote (a copy, or a shader), visible to the host once the pass's fence signals.
   void host_barrier(VkPipelineStageFlags stage = VK_PIPELINE_STAGE_TRANSFER_BIT) {
     VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
@@ -137,22 +137,15 @@ class VulkanNetwork::Recorder {
 
   // A product (conv2d, matmul or winograd_gemm) of m × n outputs, `batches` times, on the
   // kernels the network runs its products on (product_kernels.hpp): every variant takes the
-  // scalar shader's parameters, in the tile gemm_tile_for() chooses. `what` names the layer in
-  // a too-large-for-one-dispatch error.
+  // scalar shader's parameters, in the tile gemm_tile_for() chooses (or `tile`, for a product
+  // whose epilogue needs that one). `what` names the layer in a too-large-for-one-dispatch error.
   template <Shader S>
   void product(std::array<const Buffer*, kShaderBindings> bindings, const typename ShaderParams<S>::type& push,
-               const Work& work, long m, long n, const char* what, uint32_t batches = 1) {
-    const GemmTile tile = gemm_tile_for(m, n, batches, net_.gemm_tiles_);
+               const Work& work, long m, long n, const char* what, uint32_t batches = 1,
+               std::optional<GemmTile> chosen = std::nullopt) {
+    const GemmTile tile = chosen ? *chosen : gemm_tile_for(m, n, batches, net_.gemm_tiles_);
     record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work,
                     {tiles(n, what, tile.columns()), tiles(m, what, tile.rows()), batches}, tile);
-  }
-
-  // The same in `tile`, whatever the grid: a product whose epilogue needs that tile.
-  template <Shader S>
-  void product_in_tile(std::array<const Buffer*, kShaderBindings> bindings, const typename ShaderParams<S>::type& push,
-                       const Work& work, long m, long n, const char* what, GemmTile tile) {
-    record_dispatch(product_shader(S, net_.products_), bindings, &push, sizeof push, work,
-                    {tiles(n, what, tile.columns()), tiles(m, what, tile.rows()), 1}, tile);
   }
 
   // `tile`: a product's (its kernel's specialization); other shaders have none.

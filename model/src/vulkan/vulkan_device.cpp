@@ -74,7 +74,10 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
                                                             "; `neuflow devices` lists them)");
   }
   // What the shaders need: Vulkan 1.1 SPIR-V, workgroups of 256 invocations (16×16 tiles), and
-  // up to 10 KiB of shared memory (flash_attention.comp).
+  // up to 32 KiB of shared memory: the fused Winograd convolutions take 27 KiB (scalar) and
+  // 30 KiB (on fragments), the products on fragments 28.5 KiB in 128×128 tiles, the mask's
+  // product with the convex upsampling 30.5 KiB (conv2d_convex on fragments). Every GPU this
+  // targets has at least that (Jetson and NVIDIA 48 KiB, AMD and Intel 64 KiB, lavapipe 32 KiB).
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(devices[static_cast<std::size_t>(index)], &props);
   const std::string label = "vulkan device " + std::to_string(index) + " (" + props.deviceName + ")";
@@ -82,11 +85,11 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
     throw BackendError(BackendError::Kind::unavailable, label + ": supports only Vulkan 1.0; the shaders need 1.1");
   }
   if (props.limits.maxComputeWorkGroupInvocations < 256 || props.limits.maxComputeWorkGroupSize[0] < 256 ||
-      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 16384) {
+      props.limits.maxComputeWorkGroupSize[1] < 16 || props.limits.maxComputeSharedMemorySize < 32768) {
     throw BackendError(BackendError::Kind::unavailable,
-                       label +
-                           ": compute workgroups are too small for the shaders (they need 256 invocations and "
-                           "16 KiB of shared memory, Vulkan's minimum)");
+                       label + ": compute workgroups are too small for the shaders (they need 256 invocations and " +
+                           "32 KiB of shared memory; it has " +
+                           std::to_string(props.limits.maxComputeSharedMemorySize / 1024) + " KiB)");
   }
   if (props.limits.maxPerStageDescriptorStorageBuffers < kShaderBindings) {
     throw BackendError(BackendError::Kind::unavailable,

@@ -227,8 +227,11 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
     } else if (const auto* conv = std::get_if<graph::Conv2d<DeviceTensor>>(&ops[i].op);
                conv && conv->weights == &r.device_weights().upsample_conv3 && !r.observing() && i + 1 < ops.size()) {
       const auto* upsample = std::get_if<graph::ConvexUpsample>(&ops[i + 1].op);
-      if (upsample && !f.absorbed[i + 1] && upsample->mask.tensor == conv->out.tensor && upsample->mask.channel == 0 &&
-          upsample->mask.c == tensors.at(conv->out.tensor).c && !read_after(ops, i + 1, conv->out.tensor, false)) {
+      // The fused dispatch writes neither the mask nor the upsampling's output tensor, only the
+      // flow the host takes: nothing on the device may read either.
+      if (upsample && !f.absorbed[i + 1] && !f.conv_parts[i] && upsample->mask.tensor == conv->out.tensor &&
+          upsample->mask.channel == 0 && upsample->mask.c == tensors.at(conv->out.tensor).c &&
+          !read_after(ops, i + 1, conv->out.tensor, false) && !read_after(ops, i + 1, upsample->out.tensor, false)) {
         f.absorbed[i + 1] = true;
         f.convex_after[i] = upsample;
       }

@@ -2,6 +2,8 @@
 
 namespace neuflow::model::vulkan {
 
+static_assert(kGemmTile64.rows() == DeviceWeights::kConvexTileRows, "the mask's rows are ordered for 64-row tiles");
+
 void record_op(Recorder& r, const graph::ConvexUpsample& op, bool planar) {
   const View mask = r.view(op.mask), flow = r.view(op.flow), out = r.view(op.out);
   require_whole(mask, "convex upsampling");
@@ -45,12 +47,13 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& mask, const graph
                        flow.offset(),
                        1.f};
   const long plane = static_cast<long>(flow.h) * flow.w;
-  const long long mask_values = static_cast<long long>(mask.weights->out_channels) * plane;
-  const long long read = in.count() + flow.count() + static_cast<long long>(mask.weights->out_channels) * (in.c + 1);
+  // All the tiles' rows count, the zero ones included: they are multiplied all the same.
+  const long long rows = w.out_channels;
+  const long long read = in.count() + flow.count() + rows * (in.c + 1);
   const long long written = static_cast<long long>(sizeof(float)) * out.count();
-  r.product_in_tile<Shader::conv2d_convex>({&r.weights(), in.buffer, &r.flow_out(), flow.buffer}, p,
-                                           {r.bytes(read), written, mask_values * in.c + 9LL * out.count()},
-                                           w.out_channels, plane, "the upsampler's mask", kGemmTile64);
+  r.product<Shader::conv2d_convex>({&r.weights(), in.buffer, &r.flow_out(), flow.buffer}, p,
+                                   {r.bytes(read), written, rows * plane * in.c + 9LL * out.count()}, w.out_channels,
+                                   plane, "the upsampler's mask", 1, kGemmTile64);
   r.handed_out(op.out.tensor);
 }
 

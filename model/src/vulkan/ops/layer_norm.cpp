@@ -22,8 +22,13 @@ void record_op(Recorder& r, const graph::LayerNorm<DeviceTensor>& op, const grap
                           unstacked ? out2.offset() : 0};
   const long long written = static_cast<long long>(in.c) * tokens;
   const long long read = in.count() + (then ? 4LL : 2LL) * in.c + (op.residual ? written : 0);
-  r.dispatch<Shader::layer_norm>({&r.weights(), in.buffer, out.buffer, residual.buffer, out2.buffer}, p,
-                                 {r.bytes(read), r.bytes(written), 0}, groups(tokens, 16));
+  const Work work{r.bytes(read), r.bytes(written), 0};
+  if (unstacked) {
+    r.dispatch<Shader::layer_norm_unstacked>({&r.weights(), in.buffer, out.buffer, residual.buffer, out2.buffer}, p,
+                                             work, groups(tokens, 16));
+  } else {
+    r.dispatch<Shader::layer_norm>({&r.weights(), in.buffer, out.buffer, residual.buffer}, p, work, groups(tokens, 16));
+  }
 }
 
 }  // namespace neuflow::model::vulkan

@@ -12,6 +12,8 @@ layout(std430, binding = 1) readonly buffer Flow8 { VALUE flow8[]; };
 layout(std430, binding = 2) writeonly buffer FlowOut { float flow_out[]; };
 layout(std430, binding = 3) writeonly buffer Planar { VALUE planar[]; };
 #include "params/convex_upsample_params.h"
+#define CONVEX_FLOW8(i) float(flow8[i])
+#include "convex_combination.glsl"
 
 void main() {
   const int plane8 = p.h8 * p.w8;
@@ -20,23 +22,8 @@ void main() {
     const int Y = i / W, X = i - Y * W;
     const int y = Y / 8, a = Y % 8, x = X / 8, b = X % 8;
     float logit[9];
-    float m = -3.402823e38;
-    for (int k = 0; k < 9; ++k) {
-      logit[k] = float(mask[(k * 64 + a * 8 + b) * plane8 + y * p.w8 + x]);
-      m = max(m, logit[k]);
-    }
-    float sum = 0.0, u = 0.0, v = 0.0;
-    for (int k = 0; k < 9; ++k) {
-      const float e = exp(logit[k] - m);
-      const int yy = y + k / 3 - 1, xx = x + k % 3 - 1;
-      const bool inside = yy >= 0 && yy < p.h8 && xx >= 0 && xx < p.w8;
-      sum += e;
-      if (inside) {
-        u += e * float(flow8[yy * p.w8 + xx]);
-        v += e * float(flow8[plane8 + yy * p.w8 + xx]);
-      }
-    }
-    const vec2 f = vec2(8.0 * u / sum, 8.0 * v / sum);
+    for (int k = 0; k < 9; ++k) logit[k] = float(mask[(k * 64 + a * 8 + b) * plane8 + y * p.w8 + x]);
+    const vec2 f = convex_flow(logit, y, x, p.h8, p.w8);
     flow_out[2 * i] = f.x;
     flow_out[2 * i + 1] = f.y;
     if (p.planar != 0) {

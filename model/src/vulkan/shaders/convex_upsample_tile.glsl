@@ -4,16 +4,21 @@
 // filters' rows reordered at upload, DeviceWeights::convex_mask: tile t holds subpixels
 // t·(BM / 9) on, row g·9 + k their neighbour k; rows past them zero), its BN columns 1/8 pixels.
 // The tile's sums plus bias go to workgroup memory; then each (subpixel, pixel) of it is
-// convex_upsample.comp's arithmetic: the flow's full-size pixel (8y + a, 8x + b), interleaved
+// convex_combination.glsl's arithmetic: the flow's full-size pixel (8y + a, 8x + b), interleaved
 // fp32 into binding 2 (the host's read-back buffer), the 1/8 flow from binding 3 at p.add_off.
 // Needs BM, BN, the bindings and the push constants (conv2d_params.h) declared.
 
+#define CONVEX_FLOW8(i) float(d_data[p.add_off + (i)])
+#include "convex_combination.glsl"
+
 const int CONVEX_GROUPS = BM / 9;  // subpixels a tile
-shared float logits[BM][BN + 1];
+shared float logits[CONVEX_GROUPS * 9][BN + 1];  // the tile's zero rows past them are dropped
 
 void convex_store(int m, int n, float sum) {
-  const int row0 = int(gl_WorkGroupID.y) * BM, col0 = int(gl_WorkGroupID.x) * BN;
-  logits[m - row0][n - col0] = p.alpha * sum + (p.bias_off >= 0 ? float(a_data[p.bias_off + m]) : 0.0);
+  const int row = m - int(gl_WorkGroupID.y) * BM, col0 = int(gl_WorkGroupID.x) * BN;
+  if (row < CONVEX_GROUPS * 9) {
+    logits[row][n - col0] = p.alpha * sum + (p.bias_off >= 0 ? float(a_data[p.bias_off + m]) : 0.0);
+  }
 }
 
 // After every invocation's convex_store() and a barrier.
@@ -26,20 +31,11 @@ void convex_upsample_tile(int tid, int invocations) {
     const int pix = col0 + n, s = s0 + g;
     if (pix >= plane8 || s >= 64) continue;
     const int y = pix / p.out_w, x = pix - y * p.out_w;
-    float m = -3.402823e38;
-    for (int k = 0; k < 9; ++k) m = max(m, logits[g * 9 + k][n]);
-    float sum = 0.0, u = 0.0, v = 0.0;
-    for (int k = 0; k < 9; ++k) {
-      const float e = exp(logits[g * 9 + k][n] - m);
-      const int yy = y + k / 3 - 1, xx = x + k % 3 - 1;
-      sum += e;
-      if (yy >= 0 && yy < p.out_h && xx >= 0 && xx < p.out_w) {
-        u += e * float(d_data[p.add_off + yy * p.out_w + xx]);
-        v += e * float(d_data[p.add_off + plane8 + yy * p.out_w + xx]);
-      }
-    }
+    float logit[9];
+    for (int k = 0; k < 9; ++k) logit[k] = logits[g * 9 + k][n];
+    const vec2 f = convex_flow(logit, y, x, p.out_h, p.out_w);
     const int i = (8 * y + s / 8) * W + 8 * x + s % 8;
-    c_data[2 * i] = 8.0 * u / sum;
-    c_data[2 * i + 1] = 8.0 * v / sum;
+    c_data[2 * i] = f.x;
+    c_data[2 * i + 1] = f.y;
   }
 }

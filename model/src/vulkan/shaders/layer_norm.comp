@@ -8,14 +8,16 @@
 // tokens, 16 invocations per token each summing every 16th channel, the partial sums reduced in
 // workgroup memory: 16 times the workgroups of one invocation per token (112 rather than 7 at
 // 1792 tokens), with adjacent invocations still reading adjacent tokens. Two passes (mean, then
-// variance about it), as the CPU computes it. Both frames' tokens may go to tensors of their own
-// (p.split, unstacked_output.hpp).
+// variance about it), as the CPU computes it. With UNSTACKED (layer_norm_unstacked) both frames'
+// tokens go to tensors of their own (p.split, unstacked_output.hpp).
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(std430, binding = 0) readonly buffer W { VALUE w[]; };
 layout(std430, binding = 1) readonly buffer X { VALUE x[]; };
 layout(std430, binding = 2) buffer Out { VALUE dst[]; };
 layout(std430, binding = 3) readonly buffer R { VALUE res[]; };
+#ifdef UNSTACKED
 layout(std430, binding = 4) writeonly buffer Out2 { VALUE dst2[]; };
+#endif
 #include "params/layer_norm_params.h"
 
 const int TOKENS = 16, LANES = 16;
@@ -61,13 +63,15 @@ void main() {
       float o = (float(x[p.x_off + c * p.tokens + t]) - mean) * inv * float(w[p.gamma_off + c]) + float(w[p.beta_off + c]);
       if (p.res_off >= 0) o += float(res[p.res_off + c * p.tokens + t]);
       if (p.scale_off >= 0) o = o * float(w[p.scale_off + c]) + float(w[p.shift_off + c]);
-      if (p.split <= 0) {
-        dst[p.out_off + c * p.tokens + t] = VALUE(o);
-      } else if (t < p.split) {
+#ifdef UNSTACKED
+      if (t < p.split) {
         dst[p.out_off + c * p.split + t] = VALUE(o);
       } else {
         dst2[p.out2_off + c * p.split + t - p.split] = VALUE(o);
       }
+#else
+      dst[p.out_off + c * p.tokens + t] = VALUE(o);
+#endif
     }
   }
 }

@@ -8,8 +8,8 @@ NEUFLOW_PUSH_CONSTANTS(LayerNormParams)
   int res_off;  // < 0: no residual
   int gamma_off, beta_off;
   int scale_off, shift_off;  // < 0: no folded BatchNorm after it (out = out · scale + shift)
-  // > 0: the tokens are both frames' (frame 0's first), `split` each; frame 1's go to binding 4
-  // from out2_off, and each frame's output planes are `split` tokens apart.
+  // layer_norm_unstacked: the tokens are both frames' (frame 0's first), `split` each; frame 1's
+  // go to binding 4 from out2_off, and each frame's output planes are `split` tokens apart.
   int split, out2_off;
 NEUFLOW_PUSH_CONSTANTS_END
 
