@@ -75,8 +75,7 @@ std::shared_ptr<VulkanDevice> VulkanDevice::open(int index) {
   }
   // What the shaders need: Vulkan 1.1 SPIR-V, workgroups of 256 invocations (16×16 tiles), and
   // up to 32 KiB of shared memory: the fused Winograd convolutions take 27 KiB (scalar) and
-  // 30 KiB (on fragments), the products on fragments 28.5 KiB in 128×128 tiles, the mask's
-  // product with the convex upsampling 30.5 KiB (conv2d_convex on fragments). Every GPU this
+  // 30 KiB (on fragments), the products on fragments 28.5 KiB in 128×128 tiles. Every GPU this
   // targets has at least that (Jetson and NVIDIA 48 KiB, AMD and Intel 64 KiB, lavapipe 32 KiB).
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(devices[static_cast<std::size_t>(index)], &props);

@@ -119,10 +119,16 @@ void main() {
     barrier();
   }
 
-  for (int i = 0; i < TM; ++i)
-    for (int j = 0; j < TN; ++j) PRODUCT_STORE(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
 #ifdef CONVEX_UPSAMPLE
-  barrier();
-  convex_upsample_tile(tid, 256);
+  for (convex_half = 0; convex_half < 2; ++convex_half) {
+    for (int i = 0; i < TM; ++i)
+      for (int j = 0; j < TN; ++j) convex_store(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+    barrier();
+    convex_upsample_tile(tid, 256);
+    barrier();
+  }
+#else
+  for (int i = 0; i < TM; ++i)
+    for (int j = 0; j < TN; ++j) gemm_store(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
 #endif
 }

@@ -148,6 +148,9 @@ void main() {
 
   // The sums leave a fragment at a time through workgroup memory, so that the epilogue knows
   // where each is (a cooperative matrix's layout across invocations is the driver's).
+#ifdef CONVEX_UPSAMPLE
+  for (convex_half = 0; convex_half < 2; ++convex_half) {
+#endif
   const int out_row = ((tid / 32) / WARPS_N) * F * FM, out_col = ((tid / 32) % WARPS_N) * F * FN;
   for (int i = 0; i < FM; ++i)
     for (int j = 0; j < FN; ++j) {
@@ -164,6 +167,8 @@ void main() {
       barrier();
     }
 #ifdef CONVEX_UPSAMPLE
-  convex_upsample_tile(tid, INVOCATIONS);
+    convex_upsample_tile(tid, INVOCATIONS);
+    barrier();
+  }
 #endif
 }
