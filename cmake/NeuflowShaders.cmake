@@ -4,13 +4,16 @@
 # push-constant struct), so adding a shader is one line of CMake and one params header.
 #
 #   neuflow_shader(<name> SOURCE <file.comp> [DEFINES <macro>...] [PARAMS <shader>] [FP16_ONLY]
-#                  [TENSOR_CORES])
+#                  [TENSOR_CORES] [UNOPTIMIZED])
 #     compiles <file.comp> (with -D<macro>...) into <name>.spv.inc and <name>_fp16.spv.inc (-DFP16:
 #     tensors stored as float16_t, precision.glsl). Its push constants are declared once, in
 #     shaders/params/<name>_params.h as the struct <Name>Params (snake case to camel case), or
 #     are those of the shader PARAMS names (a variant of it, recorded in its place).
-#     FP16_ONLY: only the fp16 variant exists (its fp32 SPIR-V is empty). TENSOR_CORES: it needs
-#     VK_NV_cooperative_matrix (GpuDevice::tensor_cores); its pipelines are made only there.
+#     FP16_ONLY: only the fp16 variant exists (its fp32 SPIR-V is empty). TENSOR_CORES: compiled
+#     with -DTENSOR_CORES, it needs VK_NV_cooperative_matrix (GpuDevice::tensor_cores); its
+#     pipelines are made only there. UNOPTIMIZED: glslc without -O, for the shaders whose
+#     arithmetic on cooperative-matrix values crashes Debian 12's spirv-opt (2023.1, in
+#     simplify-instructions); the driver optimizes them all the same.
 #   neuflow_shader_registry(<target>)
 #     writes shader_registry.hpp/.cpp into the shader output folder and adds them to <target>.
 #
@@ -33,7 +36,13 @@ function(neuflow_shader_struct_name name out)
 endfunction()
 
 function(neuflow_shader name)
-  cmake_parse_arguments(ARG "FP16_ONLY;TENSOR_CORES" "SOURCE;PARAMS" "DEFINES" ${ARGN})
+  cmake_parse_arguments(ARG "FP16_ONLY;TENSOR_CORES;UNOPTIMIZED" "SOURCE;PARAMS" "DEFINES" ${ARGN})
+  # A keyword among the macros would end the DEFINES list there and drop the macros after it
+  # (TENSOR_CORES once did, and its shaders compiled as their twins): nothing may be left over.
+  if(ARG_UNPARSED_ARGUMENTS)
+    message(FATAL_ERROR "neuflow_shader(${name}): unexpected '${ARG_UNPARSED_ARGUMENTS}' (DEFINES takes macro "
+                        "names; TENSOR_CORES is an option that defines its macro itself)")
+  endif()
   if(NOT ARG_SOURCE)
     message(FATAL_ERROR "neuflow_shader(${name}): SOURCE <file.comp> is required")
   endif()
@@ -57,6 +66,12 @@ function(neuflow_shader name)
     endforeach()
     if(variant STREQUAL "_fp16")
       list(APPEND defines -DFP16)
+    endif()
+    if(ARG_TENSOR_CORES)
+      list(APPEND defines -DTENSOR_CORES)
+    endif()
+    if(ARG_UNOPTIMIZED AND neuflow_shader_compiler STREQUAL "glslc")
+      list(APPEND defines -O0)  # after the command's -O, which it overrides
     endif()
     add_custom_command(
       OUTPUT ${shader_out}/${name}${variant}.spv.inc

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -69,6 +70,29 @@ TEST(VulkanPipelines, EveryShaderIsValidSpirv) {
     }
   }
   EXPECT_GE(validated, static_cast<int>(kShaderCount));
+}
+
+// The shaders that need tensor cores are compiled with TENSOR_CORES, and only they: their
+// SPIR-V declares cooperative matrices (a CMake keyword among a shader's macros once dropped
+// the macro, and every tensor-core shader was its twin). No device here runs them, so this is
+// what holds the build to it.
+TEST(VulkanPipelines, OnlyTheTensorCoreShadersUseCooperativeMatrices) {
+  constexpr std::uint32_t kOpCapability = 17, kCapabilityCooperativeMatrixNV = 5357;
+  int tensor_core_shaders = 0;
+  for (std::size_t i = 0; i < kShaderCount; ++i) {
+    const auto shader = static_cast<Shader>(i);
+    const auto words = spirv(shader, true);
+    bool cooperative = false;
+    for (std::size_t at = 5; at < words.size();) {  // after the header, instruction by instruction
+      const std::uint32_t count = words[at] >> 16, opcode = words[at] & 0xffffU;
+      ASSERT_GT(count, 0U) << shader_name(shader);
+      if (opcode == kOpCapability && words[at + 1] == kCapabilityCooperativeMatrixNV) cooperative = true;
+      at += count;
+    }
+    EXPECT_EQ(cooperative, shader_info(shader).tensor_cores) << shader_name(shader);
+    tensor_core_shaders += shader_info(shader).tensor_cores ? 1 : 0;
+  }
+  EXPECT_GE(tensor_core_shaders, 6);
 }
 
 }  // namespace
