@@ -154,23 +154,26 @@ TEST_F(VulkanSession, EveryWayOfConvolvingGivesTheCpusFlow) {
 }
 
 // An unobserved pass records some ops inside others' dispatches (a refinement step's update in
-// the next step's correlation, at both scales with these iterations; a scale's last update with
-// the resample of its flow that follows it; both parts of a concatenation; the attention's
-// BatchNorm in its LayerNorm; each 8-bit frame's conversion and its pyramid's three poolings in
-// one): its flow is still the CPU's, also where a scale has no steps (the 1/16 flow then goes to
-// 1/8 by itself, or the 1/16 step's update is followed by the upsampler's input).
+// the next step's correlation, at both scales with these iterations, and at 1/8, where the
+// layers take Winograd at this size, that correlation beside the step's conv3; a scale's last
+// update with the resample of its flow that follows it; both parts of a concatenation; the
+// attention's BatchNorm in its LayerNorm; each 8-bit frame's conversion and its pyramid's three
+// poolings in one): its flow is still the CPU's, also where a scale has no steps (the 1/16 flow
+// then goes to 1/8 by itself, or the 1/16 step's update is followed by the upsampler's input).
 TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
   cv::Mat a, b;
-  cv::resize(frames_[0], a, cv::Size(128, 96), 0, 0, cv::INTER_AREA);
-  cv::resize(frames_[1], b, cv::Size(128, 96), 0, 0, cv::INTER_AREA);
+  cv::resize(frames_[0], a, cv::Size(160, 128), 0, 0, cv::INTER_AREA);
+  cv::resize(frames_[1], b, cv::Size(160, 128), 0, 0, cv::INTER_AREA);
   const Iterations iterations{2, 3};
   FlowSession cpu(model_, {.iterations = iterations, .threads = 2, .backend = Backend::cpu});
   FlowSession gpu(model_, {.iterations = iterations, .backend = Backend::vulkan});
   const Errors e = compare(gpu.compute(view_of(a), view_of(b)), cpu.compute(view_of(a), view_of(b)));
   EXPECT_LT(e.max, 1e-2);
   EXPECT_LT(e.mean, 1e-3);
-  // Every correlation in the update's form: each scale's first one starts the step input.
-  EXPECT_EQ(test::dispatches_of(gpu.device_work(), "local_correlation_update"), iterations.s16 + iterations.s8);
+  // Every correlation in the update's form (each scale's first one starts the step input), but
+  // the 1/8 ones after a step, beside its conv3.
+  EXPECT_EQ(test::dispatches_of(gpu.device_work(), "local_correlation_update"), iterations.s16 + 1);
+  EXPECT_EQ(test::dispatches_of(gpu.device_work(), "winograd_conv_step"), iterations.s8 - 1);
   EXPECT_EQ(test::dispatches_of(gpu.device_work(), "frame_pyramid"), 2) << "one a frame";
   for (const Iterations other : {Iterations{1, 0}, Iterations{0, 2}}) {
     SCOPED_TRACE(std::to_string(other.s16) + "+" + std::to_string(other.s8));

@@ -44,7 +44,7 @@ inline ProductKernels product_kernels_for(const GpuDevice& device, bool fp16) {
 }
 
 // The shader that computes the product `scalar` (conv2d, matmul, winograd_gemm, the fused
-// winograd_conv or conv2d_convex) with `kernels`.
+// winograd_conv and its variants, or conv2d_convex) with `kernels`.
 inline Shader product_shader(Shader scalar, ProductKernels kernels) {
   if (kernels == ProductKernels::scalar) return scalar;
   const bool cores = kernels == ProductKernels::tensor_cores;
@@ -56,6 +56,8 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
     case Shader::winograd_conv: return cores ? Shader::winograd_conv_coopmat : Shader::winograd_conv_coopmat_twin;
     case Shader::winograd_conv_parts:
       return cores ? Shader::winograd_conv_parts_coopmat : Shader::winograd_conv_parts_coopmat_twin;
+    case Shader::winograd_conv_step:
+      return cores ? Shader::winograd_conv_step_coopmat : Shader::winograd_conv_step_coopmat_twin;
     default: throw std::logic_error(std::string("product_shader: ") + shader_name(scalar) + " is not a product");
   }
 }
@@ -64,7 +66,7 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
 // other kernels' products.
 inline bool records(Shader shader, ProductKernels kernels) {
   for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::winograd_gemm, Shader::winograd_conv,
-                              Shader::winograd_conv_parts, Shader::conv2d_convex}) {
+                              Shader::winograd_conv_parts, Shader::winograd_conv_step, Shader::conv2d_convex}) {
     for (const ProductKernels k : {ProductKernels::scalar, ProductKernels::tensor_cores, ProductKernels::twin}) {
       if (product_shader(scalar, k) == shader) return k == kernels;
     }

@@ -15,10 +15,10 @@ namespace neuflow::model::vulkan {
 // Every pipeline shares one push-constant range of this size (VulkanDevice's layout): the
 // smallest maxPushConstantsSize Vulkan guarantees.
 inline constexpr std::size_t kMaxPushConstantBytes = 128;
-// Every shader's storage buffers are bindings 0 to 5 of one set layout (the fused Winograd
-// convolution on fragments needs six: the input's two parts; every GPU this runs on allows far
-// more per stage than Vulkan's minimum of 4).
-inline constexpr std::size_t kShaderBindings = 6;
+// Every shader's storage buffers are bindings 0 to 7 of one set layout (the refinement step's
+// end beside its conv3 needs eight: the convolution's five and the correlation's features and
+// flow; every GPU this runs on allows far more per stage than Vulkan's minimum of 4).
+inline constexpr std::size_t kShaderBindings = 8;
 
 struct ShaderInfo {
   const char* name;

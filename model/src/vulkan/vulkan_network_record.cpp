@@ -31,6 +31,10 @@ namespace {
 //   update or the step input there); an observed pass keeps them apart, its observer reading
 //   each step's hidden state as the step ends. A step's device time then includes the update of
 //   the step before;
+// - with that, the step's conv3 as well, where the network runs it as a one-dispatch Winograd
+//   convolution, it directly precedes the update, and nothing else reads its output: conv3
+//   computes only the hidden state, into the next step input, and the correlation's workgroups
+//   compute its delta themselves (winograd_conv_step), so conv3's output is never written;
 // - a folded BatchNorm (ChannelAffine) on a LayerNorm's output, in that LayerNorm's dispatch,
 //   where no op between them touches the tensor;
 // - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8,
@@ -53,6 +57,7 @@ struct Fusions {
   std::vector<bool> absorbed;
   std::vector<std::optional<ConvInputParts>> conv_parts;                       // of a convolution
   std::vector<const graph::RefineUpdate*> update_first;                        // of a correlation
+  std::vector<const graph::Conv2d<DeviceTensor>*> conv3_beside;                // of a correlation
   std::vector<std::pair<const graph::Zero*, const graph::Copy*>> start_first;  // of a correlation
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;         // of a LayerNorm
   std::vector<std::optional<UnstackedOutput>> unstacked;                       // of a LayerNorm
@@ -175,10 +180,40 @@ bool read_after(const graph::OpList<DeviceTensor>& ops, std::size_t i, graph::Te
   return false;
 }
 
+// The refinement step's conv3 before its update ops[i], where the step's end can be computed
+// beside it (record_op(conv3, update, correlation)): the one-dispatch Winograd convolution that
+// writes all of the update's input just before it (stage ends aside), with a bias and nothing
+// else, and whose output nothing after the correlation ops[j] reads before it is written again.
+std::optional<std::size_t> conv3_before(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors,
+                                        std::size_t i, std::size_t j, const graph::RefineUpdate& update,
+                                        const Fusions& f, Recorder& r) {
+  std::size_t k = i;
+  while (k > 0 && std::holds_alternative<graph::StageEnd>(ops[k - 1].op)) --k;
+  if (k == 0 || f.absorbed[k - 1] || f.conv_parts[k - 1] || f.convex_after[k - 1]) return std::nullopt;
+  const auto* conv = std::get_if<graph::Conv2d<DeviceTensor>>(&ops[k - 1].op);
+  if (!conv || conv->out.tensor != update.update.tensor) return std::nullopt;
+  const graph::TensorDesc& out = tensors.at(conv->out.tensor);
+  const bool fits = conv->out.channel == 0 && conv->out.c == out.c && out.c == 66 && !conv->addend &&
+                    conv->act == Activation::none && conv->weights->bias.offset >= 0 &&
+                    r.conv_algorithm() != ConvAlgorithm::winograd_split &&
+                    takes_winograd(r.conv_algorithm(), *conv, out.h, out.w);
+  if (!fits) return std::nullopt;
+  // The next step's conv3 writes the tensor again before its update reads it (or, fused in turn,
+  // neither writes nor reads it).
+  for (std::size_t m = j + 1; m < ops.size(); ++m) {
+    if (std::holds_alternative<graph::StageEnd>(ops[m].op)) continue;
+    const graph::Accesses a = accesses_of(ops[m].op);
+    if (mentions(a.reads, conv->out.tensor)) return std::nullopt;
+    if (mentions(a.writes, conv->out.tensor)) break;
+  }
+  return k - 1;
+}
+
 Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, Recorder& r) {
   Fusions f{std::vector<bool>(ops.size()),
             std::vector<std::optional<ConvInputParts>>(ops.size()),
             std::vector<const graph::RefineUpdate*>(ops.size()),
+            std::vector<const graph::Conv2d<DeviceTensor>*>(ops.size()),
             std::vector<std::pair<const graph::Zero*, const graph::Copy*>>(ops.size()),
             std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()),
             std::vector<std::optional<UnstackedOutput>>(ops.size()),
@@ -212,6 +247,10 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
           corr->out.tensor == update->flow_copy.tensor) {
         f.absorbed[i] = true;
         f.update_first[j] = update;
+        if (const auto k = conv3_before(ops, tensors, i, j, *update, f, r)) {
+          f.absorbed[*k] = true;
+          f.conv3_beside[j] = &std::get<graph::Conv2d<DeviceTensor>>(ops[*k].op);
+        }
       } else if (const auto then = j < ops.size() && !f.absorbed[j] ? as_resample(ops[j].op) : std::nullopt;
                  then && then->in.tensor == update->flow.tensor && then->in.channel == update->flow.channel &&
                  then->in.c == 2 && !then->relu) {
@@ -287,6 +326,8 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       } else {
         record_op(r, *frame);
       }
+    } else if (f.conv3_beside[i]) {
+      record_op(r, *f.conv3_beside[i], *f.update_first[i], std::get<graph::LocalCorrelation>(op));
     } else if (f.update_first[i]) {
       record_op(r, std::get<graph::LocalCorrelation>(op), f.update_first[i]);
     } else if (f.start_first[i].first) {

@@ -43,6 +43,10 @@ void record_op(Recorder& r, const graph::LocalCorrelation& op);
 // The correlation with the previous refinement step's update applied first, in one dispatch
 // (`previous` nullptr: the correlation alone).
 void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::RefineUpdate* previous);
+// The correlation with the previous step's end, computed beside that step's conv3 (`conv3`, for
+// the hidden state only) in one dispatch: conv3, `previous` and the correlation in one.
+void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& conv3, const graph::RefineUpdate& previous,
+               const graph::LocalCorrelation& op);
 // A scale's first correlation with the step input's first values (its hidden state zeroed, the
 // flow copied into it: `hidden`, `flow_copy`) in one dispatch.
 void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::Zero& hidden, const graph::Copy& flow_copy);

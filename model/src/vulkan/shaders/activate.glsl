@@ -12,6 +12,7 @@ float erf_approx(float x) {
 float activate(float v, int act) {
   if (act == kActLeakyRelu) return v > 0.0 ? v : 0.1 * v;          // LeakyReLU(0.1)
   if (act == kActRelu) return max(v, 0.0);                     // ReLU
+  if (act == kActClamp4) return clamp(v, -4.0, 4.0);          // Hardtanh(-4, 4)
   if (act == kActGelu) return 0.5 * v * (1.0 + erf_approx(v * 0.70710678118654752)); // exact GELU
   return v;
 }

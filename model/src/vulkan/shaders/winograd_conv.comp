@@ -23,7 +23,18 @@ layout(std430, binding = 3) readonly buffer Addend { VALUE addend[]; };
 #ifdef INPUT_IN_PARTS
 layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input's second part
 #endif
+#ifdef STEP_CORRELATION
+// The refinement step's end beside its conv3, which computes only the hidden state (above: the
+// output is the next step input's hidden channels, clamped): the workgroups from p.conv_groups
+// on compute conv3's delta, the new flow and the next step's correlation
+// (local_correlation_block.glsl with STEP_DELTA), which nothing the others write feeds.
+layout(std430, binding = 5) readonly buffer F0 { VALUE f0[]; };
+layout(std430, binding = 6) readonly buffer F1 { VALUE f1[]; };
+layout(std430, binding = 7) buffer Flow { VALUE flow[]; };
+#include "params/winograd_conv_step_params.h"
+#else
 #include "params/winograd_conv_params.h"
+#endif
 #include "activate.glsl"
 #define READS_INPUT_TILES
 #define WRITES_OUTPUT_TILES
@@ -75,11 +86,12 @@ void store_tile(int co, int t, int at) {
   store_output_tile(co, t / p.tiles_x, t % p.tiles_x, rows, p.bias_off >= 0 ? float(u[p.bias_off + co]) : 0.0);
 }
 
-void main() {
+// The workgroup of tiles group_t · 32 .. and output channels group_o · 16 ..
+void convolve(int group_t, int group_o) {
   const int id = int(gl_LocalInvocationIndex);
   const int row = id / 32, position = id % 32;
   const int cg = position / 8, tg = position % 8;  // channels o0 + cg + 4a, tiles t0 + tg + 8b
-  const int t0 = int(gl_WorkGroupID.x) * TILES, o0 = int(gl_WorkGroupID.y) * CHANNELS;
+  const int t0 = group_t * TILES, o0 = group_o * CHANNELS;
   float m[6][4][4];  // points 6·row + j, channel a, tile b
   for (int j = 0; j < 6; ++j)
     for (int a = 0; a < 4; ++a)
@@ -121,3 +133,12 @@ void main() {
     barrier();
   }
 }
+
+#ifdef STEP_CORRELATION
+#define CORRELATION_SCRATCH(i) staged[i]
+#define STEP_DELTA
+#include "local_correlation_block.glsl"
+#include "step_correlation_main.glsl"
+#else
+void main() { convolve(int(gl_WorkGroupID.x), int(gl_WorkGroupID.y)); }
+#endif

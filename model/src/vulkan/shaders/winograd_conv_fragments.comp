@@ -35,7 +35,15 @@ layout(std430, binding = 4) readonly buffer Filters { float16_t filters[]; };
 #ifdef INPUT_IN_PARTS
 layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input's second part
 #endif
+#ifdef STEP_CORRELATION
+// The refinement step's end beside its conv3, as winograd_conv.comp's STEP_CORRELATION.
+layout(std430, binding = 5) readonly buffer F0 { VALUE f0[]; };
+layout(std430, binding = 6) readonly buffer F1 { VALUE f1[]; };
+layout(std430, binding = 7) buffer Flow { VALUE flow[]; };
+#include "params/winograd_conv_step_params.h"
+#else
 #include "params/winograd_conv_params.h"
+#endif
 #include "activate.glsl"
 #define READS_INPUT_TILES
 #include "winograd_tile_io.glsl"
@@ -76,7 +84,8 @@ void store_column(int co, int t, int round, int c) {
   }
 }
 
-void main() {
+// The workgroup of tiles group_t · 16 .. and output channels group_o · 16 ..
+void convolve(int group_t, int group_o) {
   const int id = int(gl_LocalInvocationIndex);
   const int lane = id % 32;
 #ifdef TENSOR_CORES
@@ -84,7 +93,7 @@ void main() {
 #else
   const int row = id / 32;
 #endif
-  const int t0 = int(gl_WorkGroupID.x) * F, o0 = int(gl_WorkGroupID.y) * F;
+  const int t0 = group_t * F, o0 = group_o * F;
 
 #ifdef TENSOR_CORES
   SUMS acc[6];
@@ -163,3 +172,12 @@ void main() {
     barrier();
   }
 }
+
+#ifdef STEP_CORRELATION
+#define CORRELATION_SCRATCH(i) rows[i]
+#define STEP_DELTA
+#include "local_correlation_block.glsl"
+#include "step_correlation_main.glsl"
+#else
+void main() { convolve(int(gl_WorkGroupID.x), int(gl_WorkGroupID.y)); }
+#endif
