@@ -98,7 +98,8 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& conv3, const grap
   const int tile_groups = static_cast<int>(tiles(tile_count, "a convolution", scalar ? 32 : 16));
   const int conv_groups = tile_groups * static_cast<int>(tiles(hidden.c, "a convolution", 16));
   const long plane = static_cast<long>(out.h) * out.w;
-  const int corr_groups = static_cast<int>(std::min<long>((plane + 15) / 16, 65535 - conv_groups));
+  const int corr_groups = static_cast<int>(
+      std::min<long>((plane + kStepCorrelationPixels - 1) / kStepCorrelationPixels, 65535 - conv_groups));
   const WinogradConvStepParams p{in.c,
                                  out.h,
                                  out.w,

@@ -18,8 +18,9 @@ layout(std430, binding = 3) readonly buffer Flow { VALUE flow[]; };
 #endif
 #include "params/local_correlation_params.h"
 
-shared float scratch[1920];
+shared float scratch[120 * 16];
 #define CORRELATION_SCRATCH(i) scratch[i]
+#define CORRELATION_PIXELS 16
 #include "local_correlation_block.glsl"
 
 void main() {

@@ -9,7 +9,7 @@
 // Invocations with j >= 10 only meet the barriers.
 //
 // The including shader declares f0, f1, dst (the correlation's output) and flow (VALUE
-// buffers), and CORRELATION_SCRATCH(i), 1920 floats of workgroup memory. With APPLY_UPDATE the
+// buffers), and CORRELATION_SCRATCH(i), 120 floats a pixel of workgroup memory. With APPLY_UPDATE the
 // block also ends the refinement's previous step from conv3's output (`update`): the flow plus
 // its delta, the clamped hidden state into the step input; with STEP_DELTA it computes conv3's
 // delta itself, from conv3's input (`src`) and filters (`u`), where the including shader's
@@ -18,7 +18,9 @@
 // neither, and with update_off < 0 under APPLY_UPDATE (a scale's first correlation), the flow
 // is read as it is.
 
-const int CORR_R = 4, CORR_WIN = 9, CORR_N = 10, CORR_PIXELS = 16;
+// CORRELATION_PIXELS: the pixels of a block, as the including shader's invocations divide into
+// them (16 for local_correlation.comp's 16 × 10; 19 for 192 invocations: 190 busy).
+const int CORR_R = 4, CORR_WIN = 9, CORR_N = 10, CORR_PIXELS = CORRELATION_PIXELS;
 
 struct Correlation {
   int h, w, channels, f0_off, f1_off, flow_off, out_off;

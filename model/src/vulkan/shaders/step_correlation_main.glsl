@@ -1,6 +1,6 @@
 // main() of the refinement step's end beside its conv3 (STEP_CORRELATION): workgroups
 // 0 .. p.conv_groups - 1 convolve (tile group g % p.tile_groups, channel group
-// g / p.tile_groups: the hidden state), the rest take the correlation's 16-pixel blocks in turn.
+// g / p.tile_groups: the hidden state), the rest take the correlation's blocks in turn.
 // Which a workgroup does depends on its id alone, so its barriers stay in uniform control flow.
 void main() {
   const int g = int(gl_WorkGroupID.x);

@@ -136,6 +136,7 @@ void convolve(int group_t, int group_o) {
 
 #ifdef STEP_CORRELATION
 #define CORRELATION_SCRATCH(i) staged[i]
+#define CORRELATION_PIXELS kStepCorrelationPixels
 #define STEP_DELTA
 #include "local_correlation_block.glsl"
 #include "step_correlation_main.glsl"

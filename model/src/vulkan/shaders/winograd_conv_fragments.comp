@@ -175,6 +175,7 @@ void convolve(int group_t, int group_o) {
 
 #ifdef STEP_CORRELATION
 #define CORRELATION_SCRATCH(i) rows[i]
+#define CORRELATION_PIXELS kStepCorrelationPixels
 #define STEP_DELTA
 #include "local_correlation_block.glsl"
 #include "step_correlation_main.glsl"

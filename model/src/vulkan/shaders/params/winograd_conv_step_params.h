@@ -8,6 +8,10 @@
 #define NEUFLOW_SHADER_WINOGRAD_CONV_STEP_PARAMS_H
 #include "activation.h"
 
+// The correlation's workgroups take blocks of this many pixels (their 192 invocations: 10 rows
+// of 19 pixels, 2 idle).
+NEUFLOW_SHADER_CONST(kStepCorrelationPixels, 19)
+
 NEUFLOW_PUSH_CONSTANTS(WinogradConvStepParams)
   int in_c, h, w, in_off;
   int out_c, out_off;
