@@ -80,7 +80,7 @@ LiveRanges live_ranges(const TensorTable& tensors, const std::vector<const OpLis
       for (const Slice& w : a.writes) {
         const auto i = static_cast<std::size_t>(w.tensor);
         if (!planned(tensors.at(w.tensor))) continue;
-        const bool whole = !a.partial_rows && w.channel == 0 && w.c == tensors.at(w.tensor).c;
+        const bool whole = !a.partial_rows && tensors.whole(w);
         const bool also_read =
             std::any_of(a.reads.begin(), a.reads.end(), [&](const Slice& r) { return r.tensor == w.tensor; });
         if (!open[i] || (whole && !also_read)) {

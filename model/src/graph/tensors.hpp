@@ -61,6 +61,8 @@ class TensorTable {
   }
   // The whole tensor as a slice.
   Slice all(TensorId id) const { return {id, 0, at(id).c}; }
+  // Whether `s` is all of its tensor's channels.
+  bool whole(const Slice& s) const { return s.channel == 0 && s.c == at(s.tensor).c; }
   const TensorDesc& at(TensorId id) const { return tensors_.at(static_cast<std::size_t>(id)); }
   std::size_t size() const { return tensors_.size(); }
   const std::vector<TensorDesc>& descs() const { return tensors_; }

@@ -67,7 +67,7 @@ std::optional<InputInParts> input_in_parts_at(const graph::OpList<DeviceTensor>&
     if (!mentions(a.reads, x)) {
       if (!mentions(a.writes, x)) continue;
       const bool whole = !a.partial_rows && std::any_of(a.writes.begin(), a.writes.end(), [&](const graph::Slice& w) {
-        return w.tensor == x && w.channel == 0 && w.c == desc.c;
+        return w.tensor == x && tensors.whole(w);
       });
       if (whole) break;
       return std::nullopt;

@@ -7,18 +7,10 @@
 
 namespace neuflow::model::vulkan {
 
-namespace {
-
-bool whole(const graph::Slice& s, const graph::TensorTable& tensors) {
-  return s.channel == 0 && s.c == tensors.at(s.tensor).c;
-}
-
-}  // namespace
-
 std::optional<UnstackedOutput> unstacked_output_at(const graph::OpList<DeviceTensor>& ops,
                                                    const graph::TensorTable& tensors, std::size_t i) {
   const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&ops[i].op);
-  if (!norm || !whole(norm->out, tensors)) return std::nullopt;
+  if (!norm || !tensors.whole(norm->out)) return std::nullopt;
   const graph::TensorId stacked = norm->out.tensor;
   const graph::TensorDesc& desc = tensors.at(stacked);
   if (desc.storage != graph::Storage::transient || desc.constant || desc.h % 2 != 0) return std::nullopt;
@@ -29,12 +21,12 @@ std::optional<UnstackedOutput> unstacked_output_at(const graph::OpList<DeviceTen
   for (std::size_t k = i + 1; k < ops.size(); ++k) {
     if (!touches(ops[k].op, stacked)) continue;
     const auto* affine = std::get_if<graph::ChannelAffine<DeviceTensor>>(&ops[k].op);
-    const bool folded = affine && first && affine->inout.tensor == stacked && whole(affine->inout, tensors);
+    const bool folded = affine && first && affine->inout.tensor == stacked && tensors.whole(affine->inout);
     first = false;
     if (folded) continue;  // recorded in the LayerNorm's dispatch
     const auto* copy = std::get_if<graph::CopyRows>(&ops[k].op);
-    if (!copy || copy->in.tensor != stacked || !whole(copy->in, tensors) || copy->rows != rows || copy->out_row != 0 ||
-        copy->out.tensor == stacked || !whole(copy->out, tensors)) {
+    if (!copy || copy->in.tensor != stacked || !tensors.whole(copy->in) || copy->rows != rows || copy->out_row != 0 ||
+        copy->out.tensor == stacked || !tensors.whole(copy->out)) {
       return std::nullopt;
     }
     const graph::TensorDesc& to = tensors.at(copy->out.tensor);

@@ -84,8 +84,13 @@ std::optional<std::size_t> concat_second(const graph::OpList<DeviceTensor>& ops,
   return std::nullopt;
 }
 
-bool overlap(const View& a, const View& b) {
-  return a.buffer == b.buffer && a.offset() < b.offset() + b.count() && b.offset() < a.offset() + a.count();
+// Whether the memory plan lays `kept` over any of `others`.
+bool overlaps(Recorder& r, const graph::Slice& kept, const std::vector<graph::Slice>& others) {
+  const View a = r.view(kept);
+  return std::any_of(others.begin(), others.end(), [&](const graph::Slice& other) {
+    const View b = r.view(other);
+    return a.buffer == b.buffer && a.offset() < b.offset() + b.count() && b.offset() < a.offset() + a.count();
+  });
 }
 
 // The concatenation that ops[i] starts, where the convolutions that read it can read its parts
@@ -97,14 +102,12 @@ void find_input_in_parts(const graph::OpList<DeviceTensor>& ops, const graph::Te
   const auto found = input_in_parts_at(ops, tensors, i, r.conv_algorithm());
   if (!found) return;
   for (std::size_t p = 0; p < found->writers.size(); ++p) {
-    const View source = r.view((p == 0 ? found->parts.first : *found->parts.second).in);
+    const graph::Slice& source = (p == 0 ? found->parts.first : *found->parts.second).in;
     for (std::size_t m = found->writers[p] + 1; m <= found->readers.back(); ++m) {
       if (std::find(found->writers.begin(), found->writers.end(), m) != found->writers.end()) continue;
-      for (const graph::Slice& written : accesses_of(ops[m].op).writes) {
-        if (overlap(r.view(written), source)) {
-          throw std::logic_error("the Vulkan memory plan overlaps a concatenation's part with what " +
-                                 graph::describe(ops[m].op) + " writes before the part is read");
-        }
+      if (overlaps(r, source, accesses_of(ops[m].op).writes)) {
+        throw std::logic_error("the Vulkan memory plan overlaps a concatenation's part with what " +
+                               graph::describe(ops[m].op) + " writes before the part is read");
       }
     }
   }
@@ -120,11 +123,9 @@ void find_unstacked_output(const graph::OpList<DeviceTensor>& ops, const graph::
   const auto found = unstacked_output_at(ops, tensors, i);
   if (!found) return;
   for (const graph::Slice& frame : found->frames) {
-    for (const graph::Slice& read : accesses_of(ops[i].op).reads) {
-      if (overlap(r.view(frame), r.view(read))) {
-        throw std::logic_error("the Vulkan memory plan overlaps " + tensors.at(frame.tensor).name + " with what " +
-                               graph::describe(ops[i].op) + " reads");
-      }
+    if (overlaps(r, frame, accesses_of(ops[i].op).reads)) {
+      throw std::logic_error("the Vulkan memory plan overlaps " + tensors.at(frame.tensor).name + " with what " +
+                             graph::describe(ops[i].op) + " reads");
     }
   }
   for (const std::size_t copy : found->copies) f.absorbed[copy] = true;
@@ -193,9 +194,8 @@ std::optional<std::size_t> conv3_before(const graph::OpList<DeviceTensor>& ops, 
   const auto* conv = std::get_if<graph::Conv2d<DeviceTensor>>(&ops[k - 1].op);
   if (!conv || conv->out.tensor != update.update.tensor) return std::nullopt;
   const graph::TensorDesc& out = tensors.at(conv->out.tensor);
-  const bool fits = conv->out.channel == 0 && conv->out.c == out.c && out.c == 66 && !conv->addend &&
-                    conv->act == Activation::none && conv->weights->bias.offset >= 0 &&
-                    r.conv_algorithm() != ConvAlgorithm::winograd_split &&
+  const bool fits = tensors.whole(conv->out) && out.c == 66 && !conv->addend && conv->act == Activation::none &&
+                    conv->weights->bias.offset >= 0 && r.conv_algorithm() != ConvAlgorithm::winograd_split &&
                     takes_winograd(r.conv_algorithm(), *conv, out.h, out.w);
   if (!fits) return std::nullopt;
   // The next step's conv3 writes the tensor again before its update reads it (or, fused in turn,
