@@ -90,6 +90,11 @@ TEST(VulkanPipelines, OnlyTheTensorCoreShadersUseCooperativeMatrices) {
       at += count;
     }
     EXPECT_EQ(cooperative, shader_info(shader).tensor_cores) << shader_name(shader);
+    // ... and a shader named for tensor cores needs them (not only its twin is one)
+    const std::string name = shader_name(shader);
+    if (name.ends_with("_coopmat")) {
+      EXPECT_TRUE(shader_info(shader).tensor_cores) << name;
+    }
     tensor_core_shaders += shader_info(shader).tensor_cores ? 1 : 0;
   }
   EXPECT_GE(tensor_core_shaders, 6);

@@ -171,9 +171,11 @@ TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
   EXPECT_LT(e.max, 1e-2);
   EXPECT_LT(e.mean, 1e-3);
   // Every correlation in the update's form (each scale's first one starts the step input), but
-  // the 1/8 ones after a step, beside its conv3.
+  // the 1/8 ones after a step, beside its conv3; the 1/8 scale's last update beside its conv3.
   EXPECT_EQ(test::dispatches_of(gpu.device_work(), "local_correlation_update"), iterations.s16 + 1);
   EXPECT_EQ(test::dispatches_of(gpu.device_work(), "winograd_conv_step"), iterations.s8 - 1);
+  EXPECT_EQ(test::dispatches_of(gpu.device_work(), "winograd_conv_step_end"), 1);
+  EXPECT_EQ(test::dispatches_of(gpu.device_work(), "refine_update"), 1) << "the 1/16 layers are direct here";
   EXPECT_EQ(test::dispatches_of(gpu.device_work(), "frame_pyramid"), 2) << "one a frame";
   for (const Iterations other : {Iterations{1, 0}, Iterations{0, 2}}) {
     SCOPED_TRACE(std::to_string(other.s16) + "+" + std::to_string(other.s8));
@@ -183,6 +185,18 @@ TEST_F(VulkanSession, FusedDispatchesGiveTheCpusFlowAtBothScales) {
     EXPECT_LT(o.max, 1e-2);
     EXPECT_LT(o.mean, 1e-3);
   }
+  // At 320×256 the 1/16 layers take Winograd too (conv3 from 128 channels there): that scale's
+  // step ends beside its conv3 as well, the last one also writing the 1/8 flow, upsampled.
+  cv::resize(frames_[0], a, cv::Size(320, 256), 0, 0, cv::INTER_AREA);
+  cv::resize(frames_[1], b, cv::Size(320, 256), 0, 0, cv::INTER_AREA);
+  FlowSession cpu_large(model_, {.iterations = {2, 1}, .threads = 2, .backend = Backend::cpu});
+  FlowSession gpu_large(model_, {.iterations = {2, 1}, .backend = Backend::vulkan});
+  const Errors l = compare(gpu_large.compute(view_of(a), view_of(b)), cpu_large.compute(view_of(a), view_of(b)));
+  EXPECT_LT(l.max, 1e-2);
+  EXPECT_LT(l.mean, 1e-3);
+  EXPECT_EQ(test::dispatches_of(gpu_large.device_work(), "winograd_conv_step"), 1);
+  EXPECT_EQ(test::dispatches_of(gpu_large.device_work(), "winograd_conv_step_end"), 2);
+  EXPECT_EQ(test::dispatches_of(gpu_large.device_work(), "refine_update"), 0);
 }
 
 TEST_F(VulkanSession, StreamingGivesTheSameFlowAsPairs) {

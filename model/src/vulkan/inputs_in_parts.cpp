@@ -110,6 +110,35 @@ void extend_live_ranges(graph::LiveRanges& ranges, const graph::OpList<DeviceTen
   }
 }
 
+// `ranges` with the input of each refinement step's conv3 that a Winograd layer computes living
+// until the end of its step: the dispatch that computes conv3 beside the step's end
+// (winograd_conv_step, winograd_conv_step_end) reads it where the update, or the correlation or
+// resample after it, runs, and writes what those write (the next scale's flow) there.
+void keep_conv3_inputs_to_step_ends(graph::LiveRanges& ranges, const graph::OpList<DeviceTensor>& ops,
+                                    const graph::TensorTable& tensors, int first_op, ConvAlgorithm conv) {
+  const auto after_stage_ends = [&](std::size_t j) {
+    while (j < ops.size() && std::holds_alternative<graph::StageEnd>(ops[j].op)) ++j;
+    return j;
+  };
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    const auto* update = std::get_if<graph::RefineUpdate>(&ops[i].op);
+    if (!update) continue;
+    std::size_t k = i;
+    while (k > 0 && std::holds_alternative<graph::StageEnd>(ops[k - 1].op)) --k;
+    const auto* conv3 = k > 0 ? std::get_if<graph::Conv2d<DeviceTensor>>(&ops[k - 1].op) : nullptr;
+    if (!conv3 || conv3->out.tensor != update->update.tensor) continue;
+    const graph::TensorDesc& out = tensors.at(conv3->out.tensor);
+    if (!takes_winograd(conv, *conv3, out.h, out.w)) continue;
+    const std::size_t j = after_stage_ends(i + 1);
+    const bool joined = j < ops.size() && (std::holds_alternative<graph::LocalCorrelation>(ops[j].op) ||
+                                           as_resample(ops[j].op).has_value());
+    const int read_at = first_op + static_cast<int>(k - 1), last = first_op + static_cast<int>(joined ? j : i);
+    for (graph::LiveRange& r : ranges[static_cast<std::size_t>(conv3->in.tensor)]) {
+      if (r.first <= read_at && read_at <= r.last) r.last = std::max(r.last, last);
+    }
+  }
+}
+
 }  // namespace
 
 graph::LiveRanges planned_live_ranges(const graph::TensorTable& tensors, const graph::OpList<DeviceTensor>& encode,
@@ -119,6 +148,7 @@ graph::LiveRanges planned_live_ranges(const graph::TensorTable& tensors, const g
   extend_live_ranges(ranges, flow, tensors, static_cast<int>(encode.size()), conv);
   start_unstacked_frames_early(ranges, encode, tensors, 0);
   start_unstacked_frames_early(ranges, flow, tensors, static_cast<int>(encode.size()));
+  keep_conv3_inputs_to_step_ends(ranges, flow, tensors, static_cast<int>(encode.size()), conv);
   return ranges;
 }
 

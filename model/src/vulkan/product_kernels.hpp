@@ -58,6 +58,8 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
       return cores ? Shader::winograd_conv_parts_coopmat : Shader::winograd_conv_parts_coopmat_twin;
     case Shader::winograd_conv_step:
       return cores ? Shader::winograd_conv_step_coopmat : Shader::winograd_conv_step_coopmat_twin;
+    case Shader::winograd_conv_step_end:
+      return cores ? Shader::winograd_conv_step_end_coopmat : Shader::winograd_conv_step_end_coopmat_twin;
     default: throw std::logic_error(std::string("product_shader: ") + shader_name(scalar) + " is not a product");
   }
 }
@@ -65,8 +67,9 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
 // Whether a network whose products run on `kernels` records `shader`: every shader but the
 // other kernels' products.
 inline bool records(Shader shader, ProductKernels kernels) {
-  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::winograd_gemm, Shader::winograd_conv,
-                              Shader::winograd_conv_parts, Shader::winograd_conv_step, Shader::conv2d_convex}) {
+  for (const Shader scalar :
+       {Shader::conv2d, Shader::matmul, Shader::winograd_gemm, Shader::winograd_conv, Shader::winograd_conv_parts,
+        Shader::winograd_conv_step, Shader::winograd_conv_step_end, Shader::conv2d_convex}) {
     for (const ProductKernels k : {ProductKernels::scalar, ProductKernels::tensor_cores, ProductKernels::twin}) {
       if (product_shader(scalar, k) == shader) return k == kernels;
     }

@@ -32,7 +32,7 @@ VulkanNetwork::VulkanNetwork(std::shared_ptr<const DeviceWeights> weights, int h
     throw std::logic_error("VulkanNetwork: these Winograd convolutions need the filters transformed at upload");
   }
   block_rows_ = std::clamp(kScoreBlockFloats / std::max(tokens_, 1), 1, tokens_);
-  graph_ = graph::build_network_graph<DeviceTensor>(*weights_, height, width, kPlanIterations, block_rows_);
+  graph_ = graph::build_network_graph<DeviceTensor>(*weights_, height, width, graph::kPlanIterations, block_rows_);
   graph::check_shapes(graph_);
   // Tensors two ops apart never share a buffer: the graph puts independent ops side by side in
   // pairs (the two frames' steps, two ConvBlocks), which then run without a barrier between

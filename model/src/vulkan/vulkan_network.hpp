@@ -170,9 +170,8 @@ class VulkanNetwork {
   int next_entry_ = 0;
   std::deque<Started> started_;
   std::vector<float> staging_;  // host-side frame or read-back, as floats
-  // Planned with kPlanIterations; the flow ops of other iterations are built and checked
+  // Planned with graph::kPlanIterations; the flow ops of other iterations are built and checked
   // against the plan when first asked for.
-  static constexpr Iterations kPlanIterations{2, 2};
   graph::NetworkGraph<DeviceTensor> graph_;
   graph::MemoryPlan plan_;
   std::map<std::pair<int, int>, graph::OpList<DeviceTensor>> flow_ops_;

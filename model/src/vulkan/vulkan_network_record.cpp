@@ -34,7 +34,8 @@ namespace {
 // - with that, the step's conv3 as well, where the network runs it as a one-dispatch Winograd
 //   convolution, it directly precedes the update, and nothing else reads its output: conv3
 //   computes only the hidden state, into the next step input, and the correlation's workgroups
-//   compute its delta themselves (winograd_conv_step), so conv3's output is never written;
+//   compute its delta themselves (winograd_conv_step), so conv3's output is never written; a
+//   scale's last update likewise, with its resample (winograd_conv_step_end);
 // - a folded BatchNorm (ChannelAffine) on a LayerNorm's output, in that LayerNorm's dispatch,
 //   where no op between them touches the tensor;
 // - the frame's pyramid: three poolings in a chain, of an input whose sides are multiples of 8,
@@ -58,6 +59,7 @@ struct Fusions {
   std::vector<std::optional<ConvInputParts>> conv_parts;                       // of a convolution
   std::vector<const graph::RefineUpdate*> update_first;                        // of a correlation
   std::vector<const graph::Conv2d<DeviceTensor>*> conv3_beside;                // of a correlation
+  std::vector<const graph::Conv2d<DeviceTensor>*> conv3_before_end;            // of a RefineUpdate
   std::vector<std::pair<const graph::Zero*, const graph::Copy*>> start_first;  // of a correlation
   std::vector<const graph::ChannelAffine<DeviceTensor>*> affine_after;         // of a LayerNorm
   std::vector<std::optional<UnstackedOutput>> unstacked;                       // of a LayerNorm
@@ -204,7 +206,18 @@ std::optional<std::size_t> conv3_before(const graph::OpList<DeviceTensor>& ops, 
     if (std::holds_alternative<graph::StageEnd>(ops[m].op)) continue;
     const graph::Accesses a = accesses_of(ops[m].op);
     if (mentions(a.reads, conv->out.tensor)) return std::nullopt;
-    if (mentions(a.writes, conv->out.tensor)) break;
+    const bool rewritten = std::any_of(a.writes.begin(), a.writes.end(), [&](const graph::Slice& w) {
+      return w.tensor == conv->out.tensor && tensors.whole(w);
+    });
+    if (rewritten && !a.partial_rows) break;
+  }
+  // The dispatch reads conv3's input where ops[j] runs and writes what the ops up to it write: the
+  // memory plan keeps them apart (planned_live_ranges()), checked here all the same.
+  for (std::size_t m = k; m <= j; ++m) {
+    if (overlaps(r, conv->in, accesses_of(ops[m].op).writes)) {
+      throw std::logic_error("the Vulkan memory plan overlaps " + conv->layer + "'s input with what " +
+                             graph::describe(ops[m].op) + " writes before the step ends");
+    }
   }
   return k - 1;
 }
@@ -213,6 +226,7 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
   Fusions f{std::vector<bool>(ops.size()),
             std::vector<std::optional<ConvInputParts>>(ops.size()),
             std::vector<const graph::RefineUpdate*>(ops.size()),
+            std::vector<const graph::Conv2d<DeviceTensor>*>(ops.size()),
             std::vector<const graph::Conv2d<DeviceTensor>*>(ops.size()),
             std::vector<std::pair<const graph::Zero*, const graph::Copy*>>(ops.size()),
             std::vector<const graph::ChannelAffine<DeviceTensor>*>(ops.size()),
@@ -251,11 +265,19 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
           f.absorbed[*k] = true;
           f.conv3_beside[j] = &std::get<graph::Conv2d<DeviceTensor>>(ops[*k].op);
         }
-      } else if (const auto then = j < ops.size() && !f.absorbed[j] ? as_resample(ops[j].op) : std::nullopt;
-                 then && then->in.tensor == update->flow.tensor && then->in.channel == update->flow.channel &&
-                 then->in.c == 2 && !then->relu) {
-        f.absorbed[j] = true;
-        f.resample_after[i] = then;
+      } else {
+        std::size_t last = i;  // the last op the update's dispatch takes in
+        if (const auto then = j < ops.size() && !f.absorbed[j] ? as_resample(ops[j].op) : std::nullopt;
+            then && then->in.tensor == update->flow.tensor && then->in.channel == update->flow.channel &&
+            then->in.c == 2 && !then->relu) {
+          f.absorbed[j] = true;
+          f.resample_after[i] = then;
+          last = j;
+        }
+        if (const auto k = conv3_before(ops, tensors, i, last, *update, f, r)) {
+          f.absorbed[*k] = true;
+          f.conv3_before_end[i] = &std::get<graph::Conv2d<DeviceTensor>>(ops[*k].op);
+        }
       }
     } else if (const auto* corr = std::get_if<graph::LocalCorrelation>(&ops[i].op); corr && !f.update_first[i]) {
       if (const auto start = step_start_before(ops, i, *corr, f)) {
@@ -334,6 +356,9 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.start_first[i].first, *f.start_first[i].second);
     } else if (const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&op)) {
       record_op(r, *norm, f.affine_after[i], f.unstacked[i] ? &*f.unstacked[i] : nullptr);
+    } else if (f.conv3_before_end[i]) {
+      record_op(r, *f.conv3_before_end[i], std::get<graph::RefineUpdate>(op),
+                f.resample_after[i] ? &*f.resample_after[i] : nullptr);
     } else if (f.resample_after[i]) {
       record_op(r, std::get<graph::RefineUpdate>(op), &*f.resample_after[i]);
     } else if (f.convex_after[i]) {

@@ -53,6 +53,13 @@ void record_op(Recorder& r, const graph::LocalCorrelation& op, const graph::Zero
 // `then`: a resample (or copy) of the new flow into another tensor, written in the same dispatch
 // (or nullptr).
 void record_op(Recorder& r, const graph::RefineUpdate& op, const graph::Resample* then = nullptr);
+// A scale's last step's end computed beside its conv3 (for the hidden state only) in one
+// dispatch: conv3, the update and `then` (as above) in one.
+void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& conv3, const graph::RefineUpdate& op,
+               const graph::Resample* then);
+// Where the update writes its resampled flow (`then`'s output; an empty view without `then`),
+// checked to be the whole new flow upsampled.
+View resampled_flow(Recorder& r, const graph::RefineUpdate& op, const graph::Resample* then);
 // The flow into the ring entry's read-back buffer as the host takes it, and with `planar` (where
 // an op other than Output reads the output tensor) into that tensor as well.
 void record_op(Recorder& r, const graph::ConvexUpsample& op, bool planar = true);

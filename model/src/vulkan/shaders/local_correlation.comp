@@ -25,7 +25,7 @@ shared float scratch[120 * 16];
 
 void main() {
   const Correlation q = Correlation(p.h, p.w, p.channels, p.f0_off, p.f1_off, p.flow_off, p.out_off, p.update_off,
-                                    p.hidden_off, p.flow_copy_off, 0, 0, 0, 0);
+                                    p.hidden_off, p.flow_copy_off, 0, 0, 0, 0, -1, 1, 1.0);
   const int plane = p.h * p.w;
   // Whole blocks loop together, so every invocation reaches every barrier.
   for (int block = int(gl_WorkGroupID.x) * CORR_PIXELS; block < plane; block += int(gl_NumWorkGroups.x) * CORR_PIXELS) {

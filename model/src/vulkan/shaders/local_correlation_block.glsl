@@ -16,7 +16,9 @@
 // other workgroups compute the hidden state. Either way the new flow is written back (and into
 // the step input's flow channels) once every invocation of the block has read it. With
 // neither, and with update_off < 0 under APPLY_UPDATE (a scale's first correlation), the flow
-// is read as it is.
+// is read as it is. With STEP_UPDATE_ONLY (and STEP_DELTA) there is no correlation: a scale's
+// last step ends (update_block), its new flow also resampled into `resampled` (refine_update.comp's
+// arithmetic) where the including shader declares it.
 
 // CORRELATION_PIXELS: the pixels of a block, as the including shader's invocations divide into
 // them (16 for local_correlation.comp's 16 × 10; 19 for 192 invocations: 190 busy).
@@ -29,6 +31,8 @@ struct Correlation {
   int flow_copy_off;         // APPLY_UPDATE, STEP_DELTA: the step input's flow
   int in_c, in_off;          // STEP_DELTA: conv3's input
   int delta_w_off, delta_bias_off;  // STEP_DELTA: conv3's first two filters (OIHW) and biases
+  int resampled_off, factor;        // STEP_UPDATE_ONLY: the new flow upsampled by factor (< 0: not)
+  float scale;                      // ... and scaled
 };
 
 // [row j][column i][pixel]: the dot product with (bx + i, by + j); then 2 × [row j][pixel]: the
@@ -55,9 +59,58 @@ float delta_part(const Correlation q, int d, int j, int y, int x) {
   }
   return s;
 }
+
+// The flow (vx, vy) of pixel pix plus conv3's delta there, rounded as conv3 would have stored it;
+// invocation row j sums its part. Every invocation of the workgroup calls it (a barrier).
+void add_delta(const Correlation q, int pix, int lx, int j, bool row, inout float vx, inout float vy) {
+  if (row) {
+    const int y = pix / q.w, x = pix - y * q.w;
+    CORR_DELTA(0, j, lx) = delta_part(q, 0, j, y, x);
+    CORR_DELTA(1, j, lx) = delta_part(q, 1, j, y, x);
+  }
+  barrier();
+  if (row) {
+    float s0 = float(u[q.delta_bias_off]), s1 = float(u[q.delta_bias_off + 1]);
+    for (int r = 0; r < CORR_N; ++r) {
+      s0 += CORR_DELTA(0, r, lx);
+      s1 += CORR_DELTA(1, r, lx);
+    }
+    vx += float(VALUE(s0));
+    vy += float(VALUE(s1));
+  }
+}
 #endif
 
-// Pixels block .. block + 15, as invocation (lx, j); every invocation of the workgroup calls it
+#ifdef STEP_UPDATE_ONLY
+// A scale's last step's end for pixels block ..: the new flow into the flow, the step input's
+// flow channels and, upsampled and scaled, `resampled`.
+void update_block(const Correlation q, int block, int lx, int j) {
+  const int plane = q.h * q.w, pix = block + lx;
+  const bool row = j < CORR_N && pix < plane;
+  float v[2] = float[2](0.0, 0.0);
+  if (row) {
+    v[0] = float(flow[q.flow_off + pix]);
+    v[1] = float(flow[q.flow_off + plane + pix]);
+  }
+  add_delta(q, pix, lx, j, row, v[0], v[1]);  // every row has read the flow before its barrier
+  if (row && j == 0) {
+    const int y = pix / q.w, x = pix - y * q.w, wide = q.w * q.factor, big = plane * q.factor * q.factor;
+    for (int d = 0; d < 2; ++d) {
+      flow[q.flow_off + d * plane + pix] = VALUE(v[d]);
+      dst[q.flow_copy_off + d * plane + pix] = VALUE(v[d]);
+      if (q.resampled_off < 0) continue;
+      for (int dy = 0; dy < q.factor; ++dy) {
+        for (int dx = 0; dx < q.factor; ++dx) {
+          resampled[q.resampled_off + d * big + (y * q.factor + dy) * wide + x * q.factor + dx] = VALUE(v[d] * q.scale);
+        }
+      }
+    }
+  }
+  barrier();  // the next block writes the scratch again
+}
+#else
+
+// Pixels block .. block + CORR_PIXELS - 1, as invocation (lx, j); every invocation of the workgroup calls it
 // with the same block, as it meets barriers.
 void correlate_block(const Correlation q, int block, int lx, int j) {
   const int plane = q.h * q.w;
@@ -74,21 +127,10 @@ void correlate_block(const Correlation q, int block, int lx, int j) {
     fy = flow[q.flow_off + plane + pix];
   }
 #ifdef STEP_DELTA
-  if (row) {
-    CORR_DELTA(0, j, lx) = delta_part(q, 0, j, y, x);
-    CORR_DELTA(1, j, lx) = delta_part(q, 1, j, y, x);
-  }
-  barrier();
-  if (row) {
-    // conv3's delta as it would have stored it, then the flow plus it as the update rounds it
-    float s0 = float(u[q.delta_bias_off]), s1 = float(u[q.delta_bias_off + 1]);
-    for (int r = 0; r < CORR_N; ++r) {
-      s0 += CORR_DELTA(0, r, lx);
-      s1 += CORR_DELTA(1, r, lx);
-    }
-    fx = VALUE(float(fx) + float(VALUE(s0)));
-    fy = VALUE(float(fy) + float(VALUE(s1)));
-  }
+  float vx = float(fx), vy = float(fy);
+  add_delta(q, pix, lx, j, row, vx, vy);
+  fx = VALUE(vx);
+  fy = VALUE(vy);
 #endif
 #ifdef APPLY_UPDATE
   if (row) {
@@ -150,3 +192,4 @@ void correlate_block(const Correlation q, int block, int lx, int j) {
   }
   barrier();  // the next block writes the scratch again
 }
+#endif

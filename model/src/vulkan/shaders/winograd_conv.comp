@@ -28,8 +28,12 @@ layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input
 // output is the next step input's hidden channels, clamped): the workgroups from p.conv_groups
 // on compute conv3's delta, the new flow and the next step's correlation
 // (local_correlation_block.glsl with STEP_DELTA), which nothing the others write feeds.
+#ifdef STEP_UPDATE_ONLY
+layout(std430, binding = 5) writeonly buffer Resampled { VALUE resampled[]; };
+#else
 layout(std430, binding = 5) readonly buffer F0 { VALUE f0[]; };
 layout(std430, binding = 6) readonly buffer F1 { VALUE f1[]; };
+#endif
 layout(std430, binding = 7) buffer Flow { VALUE flow[]; };
 #include "params/winograd_conv_step_params.h"
 #else

@@ -37,8 +37,12 @@ layout(std430, binding = 5) readonly buffer In2 { VALUE src2[]; };  // the input
 #endif
 #ifdef STEP_CORRELATION
 // The refinement step's end beside its conv3, as winograd_conv.comp's STEP_CORRELATION.
+#ifdef STEP_UPDATE_ONLY
+layout(std430, binding = 5) writeonly buffer Resampled { VALUE resampled[]; };
+#else
 layout(std430, binding = 5) readonly buffer F0 { VALUE f0[]; };
 layout(std430, binding = 6) readonly buffer F1 { VALUE f1[]; };
+#endif
 layout(std430, binding = 7) buffer Flow { VALUE flow[]; };
 #include "params/winograd_conv_step_params.h"
 #else
