@@ -45,47 +45,48 @@ void record_step_end(Recorder& r, const graph::Conv2d<DeviceTensor>& conv3, cons
   const long plane = static_cast<long>(out.h) * out.w;
   const int step_groups = static_cast<int>(
       std::min<long>((plane + kStepCorrelationPixels - 1) / kStepCorrelationPixels, 65535 - conv_groups));
-  const WinogradConvStepParams p{in.c,
-                                 out.h,
-                                 out.w,
-                                 in.offset(),
-                                 hidden.c,
-                                 hidden.offset(),
-                                 tiles_x,
-                                 tile_count,
-                                 w.weight.offset + 2 * 9 * in.c,  // the hidden state's filters (scalar)
-                                 scalar ? -1 : r.device_weights().winograd_filters_of(w) + 2 * filters_in,  // ... transformed
-                                 filters_in,
-                                 winograd_filter_side(out.c),  // the transformed filters' stride
-                                 w.bias.offset + 2,
-                                 -1,
-                                 kActClamp4,
-                                 conv_groups,
-                                 tile_groups,
-                                 corr ? f0.c : 0,
-                                 corr ? f0.offset() : 0,
-                                 corr ? f1.offset() : 0,
-                                 flow.offset(),
-                                 corr ? corr_out.offset() : 0,
-                                 flow_copy.offset(),
-                                 w.weight.offset,
-                                 w.bias.offset,
-                                 then ? resampled.offset() : -1,
-                                 then ? then->factor : 1,
-                                 then ? then->scale : 1.f};
+  const WinogradConvStepParams p{
+      in.c,
+      out.h,
+      out.w,
+      in.offset(),
+      hidden.c,
+      hidden.offset(),
+      tiles_x,
+      tile_count,
+      w.weight.offset + 2 * 9 * in.c,                                            // the hidden state's filters (scalar)
+      scalar ? -1 : r.device_weights().winograd_filters_of(w) + 2 * filters_in,  // ... transformed
+      filters_in,
+      winograd_filter_side(out.c),  // the transformed filters' stride
+      w.bias.offset + 2,
+      -1,
+      kActClamp4,
+      conv_groups,
+      tile_groups,
+      corr ? f0.c : 0,
+      corr ? f0.offset() : 0,
+      corr ? f1.offset() : 0,
+      flow.offset(),
+      corr ? corr_out.offset() : 0,
+      flow_copy.offset(),
+      w.weight.offset,
+      w.bias.offset,
+      then ? resampled.offset() : -1,
+      then ? then->factor : 1,
+      then ? then->scale : 1.f};
   const long long delta_taps = 2LL * 9 * in.c;
   const long long conv_reads =
       scalar ? r.bytes(in.count() + 9LL * in.c * hidden.c + hidden.c)
              : r.bytes(in.count() + hidden.c) + 2LL * 36 * winograd_filter_side(hidden.c) * filters_in;
-  const long long read = conv_reads + r.bytes(in.count() + delta_taps + 2 + flow.count() +
-                                              (corr ? f0.count() + f1.count() : 0));
-  const long long written = r.bytes(hidden.count() + flow_copy.count() + flow.count() +
-                                    (corr ? corr_out.count() : 0) + (then ? resampled.count() : 0));
+  const long long read =
+      conv_reads + r.bytes(in.count() + delta_taps + 2 + flow.count() + (corr ? f0.count() + f1.count() : 0));
+  const long long written = r.bytes(hidden.count() + flow_copy.count() + flow.count() + (corr ? corr_out.count() : 0) +
+                                    (then ? resampled.count() : 0));
   const long long multiply_adds = 36LL * hidden.c * in.c * tile_count + delta_taps * plane +
                                   (corr ? static_cast<long long>(corr_out.count()) * f0.c : 0);
   const Buffer* filters = scalar ? nullptr : &r.device_weights().winograd_buffer;
-  const Shader shader = product_shader(corr ? Shader::winograd_conv_step : Shader::winograd_conv_step_end,
-                                       r.product_kernels());
+  const Shader shader =
+      product_shader(corr ? Shader::winograd_conv_step : Shader::winograd_conv_step_end, r.product_kernels());
   r.record_dispatch(shader,
                     {&r.weights(), in.buffer, hidden.buffer, nullptr, filters,
                      corr ? f0.buffer : (then ? resampled.buffer : nullptr), corr ? f1.buffer : nullptr, flow.buffer},
