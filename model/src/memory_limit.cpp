@@ -24,8 +24,8 @@ std::string megabytes(std::size_t bytes) { return std::to_string((bytes + kMiB -
 
 std::size_t estimate_plan_bytes(const NetworkWeights& weights, int model_height, int model_width) {
   const int tokens = std::max((model_height / 16) * (model_width / 16), 1);
-  const auto g = graph::build_network_graph<std::vector<float>>(
-      weights, model_height, model_width, graph::kPlanIterations, std::clamp(kScoreBlockFloats / tokens, 1, tokens));
+  const auto g = graph::build_network_graph<std::vector<float>>(weights, model_height, model_width, Iterations{},
+                                                                std::clamp(kScoreBlockFloats / tokens, 1, tokens));
   const graph::LiveRanges ranges = graph::live_ranges<std::vector<float>>(g.tensors, {&g.encode, &g.flow});
   std::vector<std::size_t> bytes(g.tensors.size(), 0);
   std::size_t fixed = 0;

@@ -20,7 +20,6 @@
 #include "neuflow/model/flow_session.hpp"
 #include "support/camera_frames.hpp"
 #include "support/fixtures.hpp"
-#include "support/flow_difference.hpp"
 
 namespace neuflow::model {
 namespace {
@@ -165,23 +164,6 @@ TEST_F(SessionTest, ResizeModeAtTheInputSizeEqualsPaddingMode) {
 
 // A model size whose plan would need more than max-memory is refused before the plan is made,
 // with the size, the need and the limit; smaller frames still run.
-// The CPU's memory is planned for every number of steps: with more than one step at 1/16 (one by
-// default), conv1's constant share is read at each of them and must not share memory with the
-// steps' tensors (a plan for one step let it, and two steps failed with "the memory plan overlaps
-// refine_s16.conv1.constant and refine_s16.conv_layers.0" at 320×256). Each pass gives the same
-// flow again. (The Vulkan tests hold these flows to the GPU's.)
-TEST_F(SessionTest, EveryNumberOfStepsRunsInThePlannedMemory) {
-  cv::Mat a, b;
-  cv::resize(frames_[0], a, cv::Size(320, 256), 0, 0, cv::INTER_AREA);
-  cv::resize(frames_[1], b, cv::Size(320, 256), 0, 0, cv::INTER_AREA);
-  for (const Iterations steps : {Iterations{2, 1}, Iterations{3, 0}, Iterations{0, 3}}) {
-    SCOPED_TRACE(std::to_string(steps.s16) + "+" + std::to_string(steps.s8));
-    FlowSession session(model_, {.iterations = steps, .threads = 2});
-    const auto first = session.compute(view_of(a), view_of(b));
-    EXPECT_EQ(test::differing_values(session.compute(view_of(a), view_of(b)), first), 0U);
-  }
-}
-
 TEST_F(SessionTest, APlanLargerThanMaxMemoryIsRefusedNamingTheNeed) {
   FlowSession session(model_, {.threads = 2, .max_memory_mb = 8});
   const auto problem = session.memory_problem(1280, 720);

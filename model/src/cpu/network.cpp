@@ -48,18 +48,9 @@ NetworkPlan::NetworkPlan(const NetworkWeights& weights, int height, int width, C
       if (std::holds_alternative<graph::FrameInput>(node.op)) input_ = std::get<graph::FrameInput>(node.op).out.tensor;
     }
   }
-  // The memory is planned with graph::kPlanIterations (the default's one step at 1/16 would let
-  // conv1's constant share go to the step's later tensors, which two steps then overwrite), the
-  // default's flow checked against it as the other iterations' are.
-  const auto planned = graph::build_network_graph<HostTensor>(weights, height, width, graph::kPlanIterations,
-                                                              score_block_rows(height, width));
-  if (planned.tensors.size() != graph_.tensors.size() || planned.op_ids != graph_.op_ids) {
-    throw std::logic_error("the network graph's tensors or ops depend on its iterations");
-  }
-  const std::vector<TensorStore::Block> blocks = scratch_blocks({&planned.encode, &planned.flow});
-  const std::vector<std::byte*> at = tensors_.allocate(live_ranges({&planned.encode, &planned.flow}), blocks);
+  const std::vector<TensorStore::Block> blocks = scratch_blocks({&graph_.encode, &graph_.flow});
+  const std::vector<std::byte*> at = tensors_.allocate(live_ranges({&graph_.encode, &graph_.flow}), blocks);
   for (std::size_t id = 0; id < scratch_.size(); ++id) scratch_[id].arena.bind(at[id]);
-  tensors_.check(live_ranges({&graph_.encode, &graph_.flow}), scratch_blocks({&graph_.encode, &graph_.flow}));
 }
 
 std::vector<TensorStore::Block> NetworkPlan::scratch_blocks(

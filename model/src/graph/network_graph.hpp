@@ -22,10 +22,11 @@ struct NetworkGraph {
   int height = 0, width = 0;
 };
 
-// The iterations a backend plans its memory with: two steps at each scale, so that a tensor every
-// step of a scale reads (conv1's constant share, the step input) is live across the steps, as
-// with any number of them; one step, as at 1/16 by default, would let its memory go to the
-// step's later tensors. The flow ops of other iterations are checked against the plan.
+// The iterations the Vulkan backend plans its memory with: two steps at each scale, so that a
+// tensor every step of a scale reads (conv1's constant share, the step input) is live across the
+// steps, as with any number of them; one step, as at 1/16 by default, would let its memory go to
+// the step's later tensors. The flow ops of other iterations are checked against the plan. (The
+// CPU still plans with the default iterations, and so refuses two steps at 1/16 from 320×256 on.)
 inline constexpr Iterations kPlanIterations{2, 2};
 
 // height, width: the model resolution, multiples of 16. score_block_rows: how many rows of the
