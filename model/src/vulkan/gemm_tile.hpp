@@ -21,8 +21,9 @@ struct GemmTile {
   constexpr int rows() const { return 16 * tm; }
   constexpr int columns() const { return 16 * tn; }
   // matmul_fragments.comp's workgroup: subgroups of 32, 2 across the tile's columns and 4 down
-  // its rows for 128×128 (2×4 fragments each), else 2 (2×2 fragments each at 64×64, one at 32×32).
-  int fragment_invocations() const { return rows() >= 128 ? 256 : 128; }
+  // its rows for 128×128 (2×4 fragments each), else 2 (2×2 fragments each at 64×64, one at 32×32);
+  // matmul_norm's 192×16: 4 subgroups down its rows (3 fragments each).
+  int fragment_invocations() const { return rows() >= 128 && columns() >= 128 ? 256 : 128; }
   bool operator==(const GemmTile&) const = default;
 };
 

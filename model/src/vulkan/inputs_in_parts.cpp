@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <variant>
 
+#include "vulkan/norm_in_product.hpp"
 #include "vulkan/ops/winograd.hpp"
 #include "vulkan/unstacked_output.hpp"
 
@@ -149,6 +150,8 @@ graph::LiveRanges planned_live_ranges(const graph::TensorTable& tensors, const g
   start_unstacked_frames_early(ranges, encode, tensors, 0);
   start_unstacked_frames_early(ranges, flow, tensors, static_cast<int>(encode.size()));
   keep_conv3_inputs_to_step_ends(ranges, flow, tensors, static_cast<int>(encode.size()), conv);
+  keep_product_inputs_to_norms(ranges, encode, tensors, 0);
+  keep_product_inputs_to_norms(ranges, flow, tensors, static_cast<int>(encode.size()));
   return ranges;
 }
 

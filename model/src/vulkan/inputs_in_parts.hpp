@@ -45,8 +45,9 @@ std::optional<InputInParts> input_in_parts_at(const graph::OpList<DeviceTensor>&
 
 // What the Vulkan memory plan follows: live_ranges() over the encode and flow passes, with each
 // read-in-parts source tensor living until its last reader, each unstacked frame's tensor from
-// its LayerNorm on (unstacked_output.hpp) and each Winograd conv3's input until its step's end
-// (winograd_conv_step).
+// its LayerNorm on (unstacked_output.hpp), each Winograd conv3's input until its step's end
+// (winograd_conv_step) and each product's input until the LayerNorm it computes
+// (norm_in_product.hpp).
 graph::LiveRanges planned_live_ranges(const graph::TensorTable& tensors, const graph::OpList<DeviceTensor>& encode,
                                       const graph::OpList<DeviceTensor>& flow, ConvAlgorithm conv);
 

@@ -13,6 +13,7 @@
 #include "graph/network_graph.hpp"
 #include "vulkan/inputs_in_parts.hpp"
 #include "vulkan/network_recorder.hpp"
+#include "vulkan/norm_in_product.hpp"
 #include "vulkan/one_shot_commands.hpp"
 #include "vulkan/ops/record_op.hpp"
 #include "vulkan/ops/winograd.hpp"
@@ -53,7 +54,10 @@ namespace {
 //   the copies that unstack it read it: its LayerNorm writes each frame's tokens where those
 //   copies would put them (UnstackedOutput);
 // - the convex upsampling, as the epilogue of the 1×1 convolution just before it that computes
-//   its mask (unobserved, nothing else reading the mask): the mask is never written.
+//   its mask (unobserved, nothing else reading the mask): the mask is never written;
+// - a LayerNorm (with its folded BatchNorm and unstacked output, as above), as the epilogue of
+//   the matrix product just before it whose output it normalizes and nothing else reads
+//   (norm_in_product.hpp): the product's output is never written.
 struct Fusions {
   std::vector<bool> absorbed;
   std::vector<std::optional<ConvInputParts>> conv_parts;                       // of a convolution
@@ -67,6 +71,7 @@ struct Fusions {
   std::vector<bool> pyramid;                                                   // starts here
   std::vector<std::optional<graph::Resample>> concat_first;                    // of a resample
   std::vector<std::optional<graph::Resample>> resample_after;                  // of a RefineUpdate
+  std::vector<std::optional<std::size_t>> norm_after;                          // of a Linear
 };
 
 // The resample after ops[i] that writes the channels right after its output's, with nothing
@@ -234,7 +239,8 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
             std::vector<const graph::ConvexUpsample*>(ops.size()),
             std::vector<bool>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
-            std::vector<std::optional<graph::Resample>>(ops.size())};
+            std::vector<std::optional<graph::Resample>>(ops.size()),
+            std::vector<std::optional<std::size_t>>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (!f.absorbed[i]) find_input_in_parts(ops, tensors, i, r, f);
     if (!f.absorbed[i]) find_unstacked_output(ops, tensors, i, r, f);
@@ -309,6 +315,23 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
       }
     }
   }
+  // After the others: the LayerNorm's folded BatchNorm and unstacked output are its own fusions.
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    const auto j = f.absorbed[i] ? std::nullopt : norm_after_product(ops, tensors, i);
+    if (!j || f.absorbed[*j]) continue;
+    const auto& product = std::get<graph::Linear<DeviceTensor>>(ops[i].op);
+    if (read_after(ops, *j, product.out.tensor, r.observing())) continue;
+    const auto& norm = std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op);
+    const std::vector<graph::Slice> written =
+        f.unstacked[*j] ? std::vector<graph::Slice>(f.unstacked[*j]->frames.begin(), f.unstacked[*j]->frames.end())
+                        : std::vector<graph::Slice>{norm.out};
+    if (overlaps(r, product.in, written)) {
+      throw std::logic_error("the Vulkan memory plan overlaps " + product.layer + "'s input with what " + norm.layer +
+                             " writes");
+    }
+    f.absorbed[*j] = true;
+    f.norm_after[i] = j;
+  }
   return f;
 }
 
@@ -356,6 +379,9 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.start_first[i].first, *f.start_first[i].second);
     } else if (const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&op)) {
       record_op(r, *norm, f.affine_after[i], f.unstacked[i] ? &*f.unstacked[i] : nullptr);
+    } else if (const auto j = f.norm_after[i]) {
+      record_op(r, std::get<graph::Linear<DeviceTensor>>(op), std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op),
+                f.affine_after[*j], f.unstacked[*j] ? &*f.unstacked[*j] : nullptr);
     } else if (f.conv3_before_end[i]) {
       record_op(r, *f.conv3_before_end[i], std::get<graph::RefineUpdate>(op),
                 f.resample_after[i] ? &*f.resample_after[i] : nullptr);

@@ -25,6 +25,11 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op);
 // Winograd forms.
 void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const ConvInputParts& parts);
 void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op);
+// The product with the LayerNorm `norm` of its output (with `then` and `unstacked` as the
+// LayerNorm takes them below) in one dispatch, the product's output never written
+// (norm_in_product.hpp).
+void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op, const graph::LayerNorm<DeviceTensor>& norm,
+               const graph::ChannelAffine<DeviceTensor>* then, const UnstackedOutput* unstacked);
 void record_op(Recorder& r, const graph::Attention& op);
 // `then`: a folded BatchNorm applied to the output in the same dispatch (or nullptr);
 // `unstacked`: both frames' tokens written apart, where the copies that would unstack them go.

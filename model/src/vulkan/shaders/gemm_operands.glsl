@@ -119,6 +119,8 @@ float gemm_b(GemmColumn col, GemmCursor c) {
 
 #ifdef CONVEX_UPSAMPLE
 #define PRODUCT_STORE convex_store  // convex_upsample_tile.glsl
+#elif defined(LAYER_NORM)
+#define PRODUCT_STORE norm_stage  // layer_norm_tile.glsl
 #else
 #define PRODUCT_STORE gemm_store
 

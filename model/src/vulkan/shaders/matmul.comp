@@ -8,8 +8,9 @@
 // K in steps of 16, the next step's operands loaded into registers while the current step's
 // are multiplied. Every output's products are summed in the same order at every tile size, so
 // the sizes agree to the bit. Compiled for the three kinds of product of gemm_operands.glsl
-// (IMPLICIT_CONV, WINOGRAD_GEMM, strided). Every device runs it; matmul_fragments.comp is the
-// tensor-core path of the same products.
+// (IMPLICIT_CONV, WINOGRAD_GEMM, strided), the strided one also with a LayerNorm of each column
+// as its epilogue (LAYER_NORM, layer_norm_tile.glsl: 192×16 tiles). Every device runs it;
+// matmul_fragments.comp is the tensor-core path of the same products.
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(constant_id = 0) const int TM = 4;  // outputs per invocation along M (rows of C)
 layout(constant_id = 1) const int TN = 4;  // and along N (columns of C): 1, 2, 4, 8 or 16
@@ -21,16 +22,22 @@ layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };
 #elif defined(CONVEX_UPSAMPLE)
 layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
 layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };  // the flow for the host
+#elif defined(LAYER_NORM)
+layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
+layout(std430, binding = 2) writeonly buffer BufC { VALUE c_data[]; };
+layout(std430, binding = 4) writeonly buffer BufC2 { VALUE out2[]; };  // frame 1's tokens, unstacked
 #else
 layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
 layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
 #endif
-layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend (the 1/8 flow)
+layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend (the 1/8 flow), or the residual
 
 #ifdef IMPLICIT_CONV
 #include "params/conv2d_params.h"
 #elif defined(WINOGRAD_GEMM)
 #include "params/winograd_gemm_params.h"
+#elif defined(LAYER_NORM)
+#include "params/matmul_norm_params.h"
 #else
 #include "params/matmul_params.h"
 #endif
@@ -57,6 +64,9 @@ shared STAGED tile_a[BK][BM + PAD];
 shared STAGED tile_b[BK][BN];
 #ifdef CONVEX_UPSAMPLE
 #include "convex_upsample_tile.glsl"
+#endif
+#ifdef LAYER_NORM
+#include "layer_norm_tile.glsl"
 #endif
 
 void main() {
@@ -129,6 +139,9 @@ void main() {
   }
 #else
   for (int i = 0; i < TM; ++i)
-    for (int j = 0; j < TN; ++j) gemm_store(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+    for (int j = 0; j < TN; ++j) PRODUCT_STORE(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+#ifdef LAYER_NORM
+  layer_norm_tile(tid, 256);
+#endif
 #endif
 }

@@ -6,7 +6,9 @@
 // comes from specialization constants as the scalar kernel's does (gemm_tile.hpp):
 //  - 64×64: 4 subgroups (2×2), each 2×2 fragments (the shader's own, without specialization);
 //  - 128×128: 8 subgroups (4×2), each 2×4 fragments, 256 invocations;
-//  - 32×32: 4 subgroups (2×2), each one fragment.
+//  - 32×32: 4 subgroups (2×2), each one fragment;
+//  - with LAYER_NORM (a LayerNorm of each column as the epilogue, layer_norm_tile.glsl): 192×16,
+//    4 subgroups down the rows, each 3×1 fragments.
 // Each output's fragment products are summed in K order at every size.
 //  - TENSOR_CORES: the fragments are VK_NV_cooperative_matrix matrices (16×16×16,
 //    fp16 × fp16 + fp32), taken where the device has them (GpuDevice::tensor_cores).
@@ -37,16 +39,22 @@ layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };
 #elif defined(CONVEX_UPSAMPLE)
 layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
 layout(std430, binding = 2) writeonly buffer BufC { float c_data[]; };  // the flow for the host
+#elif defined(LAYER_NORM)
+layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
+layout(std430, binding = 2) writeonly buffer BufC { VALUE c_data[]; };
+layout(std430, binding = 4) writeonly buffer BufC2 { VALUE out2[]; };  // frame 1's tokens, unstacked
 #else
 layout(std430, binding = 1) readonly buffer BufB { VALUE b_data[]; };
 layout(std430, binding = 2) buffer BufC { VALUE c_data[]; };
 #endif
-layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend (the 1/8 flow)
+layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the addend (the 1/8 flow), or the residual
 
 #ifdef IMPLICIT_CONV
 #include "params/conv2d_params.h"
 #elif defined(WINOGRAD_GEMM)
 #include "params/winograd_gemm_params.h"
+#elif defined(LAYER_NORM)
+#include "params/matmul_norm_params.h"
 #else
 #include "params/matmul_params.h"
 #endif
@@ -55,13 +63,23 @@ layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the ad
 
 const int BM = 16 * TM, BN = 16 * TN, BK = 32;  // the workgroup's tile and K step
 const int F = 16;                               // a fragment: 16×16, K 16
-const int WARPS = INVOCATIONS / 32, WARPS_N = 2, WARPS_M = WARPS / WARPS_N;
+// With LAYER_NORM the tile is every row of 16 columns (192×16, 4 subgroups down its rows).
+#ifdef LAYER_NORM
+const int WARPS_N = 1;
+#else
+const int WARPS_N = 2;
+#endif
+const int WARPS = INVOCATIONS / 32, WARPS_M = WARPS / WARPS_N;
 // A subgroup's fragments. The twin's arrays are sized by them, not by the largest tile's: an
 // array larger than its use stays in memory on lavapipe (the 64×64 twin took 2× the time). The
 // cooperative matrices' arrays keep a fixed size, the largest tile's (a form drivers have long
 // compiled), of which a smaller tile uses part.
 const int FM = BM / (F * WARPS_M), FN = BN / (F * WARPS_N);
+#ifdef LAYER_NORM
+const int MAX_FM = 3, MAX_FN = 1;
+#else
 const int MAX_FM = 2, MAX_FN = 4;
+#endif
 // Row strides in workgroup memory, padded by 16 bytes: a fragment load's rows start on 16-byte
 // boundaries (as cooperative-matrix loads need) in different banks.
 const int SA = BK + 8, SB = BN + 8, SC = F + 4;
@@ -70,6 +88,9 @@ shared float16_t tile_b[BK * SB];  // [k][n]
 shared float sums[WARPS * F * SC];  // one fragment's sums per subgroup, on their way out
 #ifdef CONVEX_UPSAMPLE
 #include "convex_upsample_tile.glsl"
+#endif
+#ifdef LAYER_NORM
+#include "layer_norm_tile.glsl"
 #endif
 
 #ifdef TENSOR_CORES
@@ -170,5 +191,8 @@ void main() {
     convex_upsample_tile(tid, INVOCATIONS);
     barrier();
   }
+#endif
+#ifdef LAYER_NORM
+  layer_norm_tile(tid, INVOCATIONS);
 #endif
 }

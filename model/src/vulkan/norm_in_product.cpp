@@ -1,0 +1,38 @@
+#include "vulkan/norm_in_product.hpp"
+
+#include <algorithm>
+#include <variant>
+
+#include "vulkan/shaders.hpp"
+
+namespace neuflow::model::vulkan {
+
+std::optional<std::size_t> norm_after_product(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors,
+                                              std::size_t i) {
+  const auto* product = std::get_if<graph::Linear<DeviceTensor>>(&ops[i].op);
+  if (!product || product->weights->out_features != kMatmulNormChannels || !tensors.whole(product->out) ||
+      i + 1 >= ops.size()) {
+    return std::nullopt;
+  }
+  const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&ops[i + 1].op);
+  if (!norm || norm->in.tensor != product->out.tensor || !tensors.whole(norm->in) ||
+      (norm->residual && norm->residual->tensor == product->out.tensor) || norm->out.tensor == product->out.tensor) {
+    return std::nullopt;
+  }
+  return i + 1;
+}
+
+void keep_product_inputs_to_norms(graph::LiveRanges& ranges, const graph::OpList<DeviceTensor>& ops,
+                                  const graph::TensorTable& tensors, int first_op) {
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    const auto norm = norm_after_product(ops, tensors, i);
+    if (!norm) continue;
+    const auto& product = std::get<graph::Linear<DeviceTensor>>(ops[i].op);
+    const int read_at = first_op + static_cast<int>(i), last = first_op + static_cast<int>(*norm);
+    for (graph::LiveRange& r : ranges[static_cast<std::size_t>(product.in.tensor)]) {
+      if (r.first <= read_at && read_at <= r.last) r.last = std::max(r.last, last);
+    }
+  }
+}
+
+}  // namespace neuflow::model::vulkan
