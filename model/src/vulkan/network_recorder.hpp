@@ -148,6 +148,16 @@ class VulkanNetwork::Recorder {
                     {tiles(n, what, tile.columns()), tiles(m, what, tile.rows()), batches}, tile);
   }
 
+  // The next dispatch touches only `v`'s values of its binding `binding`, not all of that buffer:
+  // for a kernel that reads or writes exactly that view there, so that dispatches on other values
+  // of the same buffer (the two halves of a concatenation, tensors of one memory region) need no
+  // barrier between them.
+  void touches_only(std::size_t binding, const View& v) {
+    const VkDeviceSize e = net_.elem_;
+    exact_.at(binding) = Span{v.buffer->handle(), static_cast<VkDeviceSize>(v.offset()) * e,
+                              static_cast<VkDeviceSize>(v.offset() + v.count()) * e};
+  }
+
   // `tile`: a product's (its kernel's specialization); other shaders have none.
   void record_dispatch(Shader shader, std::array<const Buffer*, kShaderBindings> bindings, const void* push,
                        std::size_t bytes, const Work& work, std::array<uint32_t, 3> grid, GemmTile tile = kGemmTile64) {
@@ -156,9 +166,15 @@ class VulkanNetwork::Recorder {
     const auto& access = shader_info(shader).bindings;
     for (std::size_t i = 0; i < handles.size(); ++i) {
       handles[i] = (bindings[i] ? *bindings[i] : net_.dummy_).handle();
-      if (access[i].reads) reads.push_back(whole(handles[i]));
-      if (access[i].writes) writes.push_back(whole(handles[i]));
+      const Span touched = exact_[i] ? *exact_[i] : whole(handles[i]);
+      if (touched.buffer != handles[i]) {
+        throw std::logic_error(std::string("the Vulkan ") + shader_name(shader) + "'s binding " + std::to_string(i) +
+                               " is not the buffer its touched values lie in");
+      }
+      if (access[i].reads) reads.push_back(touched);
+      if (access[i].writes) writes.push_back(touched);
     }
+    exact_ = {};
     order(reads, writes);
     VkDescriptorSet set = net_.descriptor_set(handles);
     vkCmdBindPipeline(commands_, VK_PIPELINE_BIND_POINT_COMPUTE, net_.device_.pipeline(shader, net_.fp16_, tile));
@@ -376,6 +392,7 @@ class VulkanNetwork::Recorder {
   // What was written and read since the last barrier; after_unknown_: nothing is known of what
   // ran before (a recording's start), so the next command waits for all of it.
   std::vector<Span> written_, read_;
+  std::array<std::optional<Span>, kShaderBindings> exact_;  // touches_only(), for the next dispatch
   bool after_unknown_ = true;
   bool barrier_before_ = false;  // the command being recorded waits for those before it
   std::array<int, 3> frames_{-1, -1, -1};

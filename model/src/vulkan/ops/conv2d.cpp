@@ -137,12 +137,22 @@ void record_winograd(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const V
                                       groups(static_cast<long>(out.c) * tile_count, kLocal));
 }
 
+// A one-dispatch convolution reads its input (or its parts: each part's buffer whole) and addend
+// and writes its output exactly where their views lie.
+void touches_only_its_views(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const View& in, const View& out,
+                            const View& addend, const ConvInputParts* parts) {
+  if (!parts) r.touches_only(1, in);
+  r.touches_only(2, out);
+  if (op.addend) r.touches_only(3, addend);
+}
+
 // F(4×4, 3×3) in one dispatch on the kernels the network runs its products on, the input from
 // `parts` where given (nullptr: from op.in).
 void record_winograd_one_dispatch(Recorder& r, const graph::Conv2d<DeviceTensor>& op, const ConvInputParts* parts) {
   const View in = r.view(op.in), out = r.view(op.out);
   const View addend = op.addend ? r.view(*op.addend) : View{};
   const long long others = (op.weights->bias.offset >= 0 ? out.c : 0) + (op.addend ? out.count() : 0);
+  touches_only_its_views(r, op, in, out, addend, parts);
   if (r.product_kernels() != ProductKernels::scalar) {
     record_winograd_fragments(r, op, in, out, addend, others, parts);
   } else {
@@ -192,6 +202,7 @@ void record_op(Recorder& r, const graph::Conv2d<DeviceTensor>& op) {
                        w.bias.offset,
                        op.addend ? addend.offset() : -1,
                        1.f};
+  touches_only_its_views(r, op, in, out, addend, nullptr);
   r.product<Shader::conv2d>({&r.weights(), in.buffer, out.buffer, addend.buffer}, p,
                             {r.bytes(read), r.bytes(out.count()), taps * out.count()}, out.c,
                             static_cast<long>(out.h) * out.w, "a convolution");
