@@ -70,6 +70,7 @@ std::shared_ptr<const FlowModel> VulkanTensorCores::model_;
 const std::set<std::string> kScalarProducts{"conv2d",
                                             "matmul",
                                             "matmul_norm",
+                                            "matmul_mlp_norm",
                                             "winograd_gemm",
                                             "winograd_conv",
                                             "winograd_conv_parts",
@@ -138,6 +139,7 @@ TEST_F(VulkanTensorCores, TheTwinRunsEveryProductOfTheNetwork) {
     EXPECT_TRUE(names.contains("conv2d_coopmat_twin")) << conv;
     EXPECT_TRUE(names.contains("matmul_coopmat_twin")) << conv;
     EXPECT_TRUE(names.contains("matmul_norm_coopmat_twin")) << conv;
+    EXPECT_TRUE(names.contains("matmul_mlp_norm_coopmat_twin")) << conv;
     EXPECT_TRUE(names.contains("conv2d_convex_coopmat_twin")) << conv;
     EXPECT_EQ(names.contains("winograd_gemm_coopmat_twin"), std::string(conv) == "winograd-split") << conv;
     EXPECT_EQ(names.contains("winograd_conv_coopmat_twin"), std::string(conv) == "winograd") << conv;

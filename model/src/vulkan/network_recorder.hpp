@@ -266,6 +266,7 @@ class VulkanNetwork::Recorder {
   ConvAlgorithm conv_algorithm() const { return net_.conv_; }
   // What the products run on (product_kernels.hpp).
   ProductKernels product_kernels() const { return net_.products_; }
+  bool fp16() const { return net_.fp16_; }  // the tensors' precision
   // F(4×4, 3×3)'s transformed input tiles and their products (fp32), which the split Winograd
   // convolutions use in turn.
   const Buffer& winograd_points() const { return net_.winograd_points_; }

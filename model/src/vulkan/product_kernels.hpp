@@ -43,7 +43,7 @@ inline ProductKernels product_kernels_for(const GpuDevice& device, bool fp16) {
   return want == "twin" ? ProductKernels::twin : ProductKernels::tensor_cores;
 }
 
-// The shader that computes the product `scalar` (conv2d, matmul, matmul_norm, winograd_gemm, the fused
+// The shader that computes the product `scalar` (conv2d, matmul, matmul_norm, matmul_mlp_norm, winograd_gemm, the fused
 // winograd_conv and its variants, or conv2d_convex) with `kernels`.
 inline Shader product_shader(Shader scalar, ProductKernels kernels) {
   if (kernels == ProductKernels::scalar) return scalar;
@@ -53,6 +53,8 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
     case Shader::conv2d_convex: return cores ? Shader::conv2d_convex_coopmat : Shader::conv2d_convex_coopmat_twin;
     case Shader::matmul: return cores ? Shader::matmul_coopmat : Shader::matmul_coopmat_twin;
     case Shader::matmul_norm: return cores ? Shader::matmul_norm_coopmat : Shader::matmul_norm_coopmat_twin;
+    case Shader::matmul_mlp_norm:
+      return cores ? Shader::matmul_mlp_norm_coopmat : Shader::matmul_mlp_norm_coopmat_twin;
     case Shader::winograd_gemm: return cores ? Shader::winograd_gemm_coopmat : Shader::winograd_gemm_coopmat_twin;
     case Shader::winograd_conv: return cores ? Shader::winograd_conv_coopmat : Shader::winograd_conv_coopmat_twin;
     case Shader::winograd_conv_parts:
@@ -68,7 +70,7 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
 // Whether a network whose products run on `kernels` records `shader`: every shader but the
 // other kernels' products.
 inline bool records(Shader shader, ProductKernels kernels) {
-  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::matmul_norm, Shader::winograd_gemm,
+  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::matmul_norm, Shader::matmul_mlp_norm, Shader::winograd_gemm,
                               Shader::winograd_conv, Shader::winograd_conv_parts, Shader::winograd_conv_step,
                               Shader::winograd_conv_step_end, Shader::conv2d_convex}) {
     for (const ProductKernels k : {ProductKernels::scalar, ProductKernels::tensor_cores, ProductKernels::twin}) {

@@ -57,7 +57,8 @@ namespace {
 //   its mask (unobserved, nothing else reading the mask): the mask is never written;
 // - a LayerNorm (with its folded BatchNorm and unstacked output, as above), as the epilogue of
 //   the matrix product just before it whose output it normalizes and nothing else reads
-//   (norm_in_product.hpp): the product's output is never written.
+//   (norm_in_product.hpp): the product's output is never written; in fp16, of an MLP's two
+//   products (the hidden layer in workgroup memory, never written either).
 struct Fusions {
   std::vector<bool> absorbed;
   std::vector<std::optional<ConvInputParts>> conv_parts;                       // of a convolution
@@ -72,6 +73,7 @@ struct Fusions {
   std::vector<std::optional<graph::Resample>> concat_first;                    // of a resample
   std::vector<std::optional<graph::Resample>> resample_after;                  // of a RefineUpdate
   std::vector<std::optional<std::size_t>> norm_after;                          // of a Linear
+  std::vector<std::optional<std::size_t>> mlp_norm_after;                      // of a Linear
 };
 
 // The resample after ops[i] that writes the channels right after its output's, with nothing
@@ -227,6 +229,20 @@ std::optional<std::size_t> conv3_before(const graph::OpList<DeviceTensor>& ops, 
   return k - 1;
 }
 
+// The fused products' input stays apart from what their LayerNorm writes (planned_live_ranges()),
+// checked here all the same.
+void check_norm_output_apart(Recorder& r, const graph::Linear<DeviceTensor>& product,
+                             const graph::LayerNorm<DeviceTensor>& norm,
+                             const std::optional<UnstackedOutput>& unstacked) {
+  const std::vector<graph::Slice> written =
+      unstacked ? std::vector<graph::Slice>(unstacked->frames.begin(), unstacked->frames.end())
+                : std::vector<graph::Slice>{norm.out};
+  if (overlaps(r, product.in, written)) {
+    throw std::logic_error("the Vulkan memory plan overlaps " + product.layer + "'s input with what " + norm.layer +
+                           " writes");
+  }
+}
+
 Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::TensorTable& tensors, Recorder& r) {
   Fusions f{std::vector<bool>(ops.size()),
             std::vector<std::optional<ConvInputParts>>(ops.size()),
@@ -240,6 +256,7 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
             std::vector<bool>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
+            std::vector<std::optional<std::size_t>>(ops.size()),
             std::vector<std::optional<std::size_t>>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (!f.absorbed[i]) find_input_in_parts(ops, tensors, i, r, f);
@@ -316,19 +333,26 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
     }
   }
   // After the others: the LayerNorm's folded BatchNorm and unstacked output are its own fusions.
+  // An MLP's two layers with it first (in fp16), where neither layer's output is read elsewhere.
+  for (std::size_t i = 0; i < ops.size(); ++i) {
+    const auto j = f.absorbed[i] || !r.fp16() ? std::nullopt : norm_after_mlp(ops, tensors, i);
+    if (!j || f.absorbed[i + 1] || f.absorbed[*j]) continue;
+    const auto& first = std::get<graph::Linear<DeviceTensor>>(ops[i].op);
+    const auto& second = std::get<graph::Linear<DeviceTensor>>(ops[i + 1].op);
+    if (read_after(ops, i + 1, first.out.tensor, r.observing()) ||
+        read_after(ops, *j, second.out.tensor, r.observing())) {
+      continue;
+    }
+    check_norm_output_apart(r, first, std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op), f.unstacked[*j]);
+    f.absorbed[i + 1] = f.absorbed[*j] = true;
+    f.mlp_norm_after[i] = j;
+  }
   for (std::size_t i = 0; i < ops.size(); ++i) {
     const auto j = f.absorbed[i] ? std::nullopt : norm_after_product(ops, tensors, i);
     if (!j || f.absorbed[*j]) continue;
     const auto& product = std::get<graph::Linear<DeviceTensor>>(ops[i].op);
     if (read_after(ops, *j, product.out.tensor, r.observing())) continue;
-    const auto& norm = std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op);
-    const std::vector<graph::Slice> written =
-        f.unstacked[*j] ? std::vector<graph::Slice>(f.unstacked[*j]->frames.begin(), f.unstacked[*j]->frames.end())
-                        : std::vector<graph::Slice>{norm.out};
-    if (overlaps(r, product.in, written)) {
-      throw std::logic_error("the Vulkan memory plan overlaps " + product.layer + "'s input with what " + norm.layer +
-                             " writes");
-    }
+    check_norm_output_apart(r, product, std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op), f.unstacked[*j]);
     f.absorbed[*j] = true;
     f.norm_after[i] = j;
   }
@@ -379,6 +403,10 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.start_first[i].first, *f.start_first[i].second);
     } else if (const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&op)) {
       record_op(r, *norm, f.affine_after[i], f.unstacked[i] ? &*f.unstacked[i] : nullptr);
+    } else if (const auto k = f.mlp_norm_after[i]) {
+      record_op(r, std::get<graph::Linear<DeviceTensor>>(op), std::get<graph::Linear<DeviceTensor>>(ops[i + 1].op),
+                std::get<graph::LayerNorm<DeviceTensor>>(ops[*k].op), f.affine_after[*k],
+                f.unstacked[*k] ? &*f.unstacked[*k] : nullptr);
     } else if (const auto j = f.norm_after[i]) {
       record_op(r, std::get<graph::Linear<DeviceTensor>>(op), std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op),
                 f.affine_after[*j], f.unstacked[*j] ? &*f.unstacked[*j] : nullptr);

@@ -30,6 +30,11 @@ void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op);
 // (norm_in_product.hpp).
 void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op, const graph::LayerNorm<DeviceTensor>& norm,
                const graph::ChannelAffine<DeviceTensor>* then, const UnstackedOutput* unstacked);
+// An MLP's two layers (`first`, `second`) and the LayerNorm `norm` of its output in one dispatch
+// (fp16), neither layer's output written.
+void record_op(Recorder& r, const graph::Linear<DeviceTensor>& first, const graph::Linear<DeviceTensor>& second,
+               const graph::LayerNorm<DeviceTensor>& norm, const graph::ChannelAffine<DeviceTensor>* then,
+               const UnstackedOutput* unstacked);
 void record_op(Recorder& r, const graph::Attention& op);
 // `then`: a folded BatchNorm applied to the output in the same dispatch (or nullptr);
 // `unstacked`: both frames' tokens written apart, where the copies that would unstack them go.

@@ -14,10 +14,25 @@
 
 #include "activate.glsl"
 
+#ifdef MLP
+// The MLP's two products in one dispatch (matmul_norm_params.h): in phase 0 its hidden layer
+// act(W1 · x + b1) for the workgroup's columns, a block of rows at a time, into workgroup memory
+// (rounded to the stored type, as the first product would have stored it); in phase 1
+// W2 · hidden, which the LayerNorm epilogue takes. The hidden layer's memory then holds the
+// second product's values for the LayerNorm (layer_norm_tile.glsl).
+shared VALUE mlp_hidden[kMlpHiddenChannels * 16 * TN];  // [hidden channel][column of the tile]
+int mlp_phase = 0;
+int mlp_col0() { return int(gl_WorkGroupID.x) * 16 * TN; }
+#endif
+
 #ifdef IMPLICIT_CONV
 int gemm_m() { return p.out_c; }
 int gemm_n() { return p.out_h * p.out_w; }
 int gemm_k() { return p.in_c * p.kernel * p.kernel; }
+#elif defined(MLP)
+int gemm_m() { return mlp_phase == 0 ? p.hidden : p.m; }
+int gemm_n() { return p.n; }
+int gemm_k() { return mlp_phase == 0 ? p.k : p.hidden; }
 #else
 int gemm_m() { return p.m; }
 int gemm_n() { return p.n; }
@@ -54,6 +69,8 @@ float gemm_a(int m, int k) {
   return float(a_data[p.w_off + m * gemm_k() + k]);
 #elif defined(WINOGRAD_GEMM)
   return float(a_data[p.w_off + (int(gl_WorkGroupID.z) * p.filters_out + m) * p.filters_in + k]);
+#elif defined(MLP)
+  return float(a_data[(mlp_phase == 0 ? p.a_off : p.w2_off) + m * gemm_k() + k]);
 #else
   return float(a_data[p.a_off + m * p.a_rs + k * p.a_cs]);
 #endif
@@ -112,6 +129,9 @@ float gemm_b(GemmColumn col, GemmCursor c) {
   return float(b_data[p.in_off + (c.ci * p.in_h + iy) * p.in_w + ix]);
 #elif defined(WINOGRAD_GEMM)
   return b_data[(int(gl_WorkGroupID.z) * gemm_k() + c.k) * gemm_n() + col.n];
+#elif defined(MLP)
+  if (mlp_phase == 1) return float(mlp_hidden[c.k * 16 * TN + col.n - mlp_col0()]);
+  return float(b_data[p.b_off + c.k * p.b_rs + col.n * p.b_cs]);
 #else
   return float(b_data[p.b_off + c.k * p.b_rs + col.n * p.b_cs]);
 #endif
@@ -119,6 +139,8 @@ float gemm_b(GemmColumn col, GemmCursor c) {
 
 #ifdef CONVEX_UPSAMPLE
 #define PRODUCT_STORE convex_store  // convex_upsample_tile.glsl
+#elif defined(MLP)
+#define PRODUCT_STORE mlp_store  // the hidden layer's, then norm_stage (layer_norm_tile.glsl)
 #elif defined(LAYER_NORM)
 #define PRODUCT_STORE norm_stage  // layer_norm_tile.glsl
 #else

@@ -8,17 +8,40 @@
 // Needs BM, BN (the tile), the bindings a_data (bias, gamma, beta, scale, shift), d_data (the
 // residual), c_data and out2 (the outputs), and gemm_operands.glsl.
 const int NORM_LANES = 16;
+#ifdef MLP
+#define normed mlp_hidden  // free again once the second product has read it
+#else
 shared VALUE normed[BM * BN];  // [row][column of the tile]
+#endif
 shared float norm_partial[NORM_LANES * BN];
 shared float norm_mean[BN], norm_inv[BN];
 
 // C[m][n] from its sum of products, before the LayerNorm: scale, bias and activation.
 void norm_stage(int m, int n, float sum) {
   if (m >= gemm_m() || n >= gemm_n()) return;
+#ifdef MLP
+  const int bias = p.bias2_off, act = p.act2;
+#else
+  const int bias = p.bias_off, act = p.act;
+#endif
+  float v = p.alpha * sum;
+  if (bias >= 0) v += float(a_data[bias + m]);
+  normed[m * BN + n - int(gl_WorkGroupID.x) * BN] = VALUE(activate(v, act));
+}
+
+#ifdef MLP
+// The first product's C[m][n] into the hidden layer (phase 0), the second's for the LayerNorm.
+void mlp_store(int m, int n, float sum) {
+  if (mlp_phase == 1) {
+    norm_stage(m, n, sum);
+    return;
+  }
+  if (m >= gemm_m() || n >= gemm_n()) return;
   float v = p.alpha * sum;
   if (p.bias_off >= 0) v += float(a_data[p.bias_off + m]);
-  normed[m * BN + n - int(gl_WorkGroupID.x) * BN] = VALUE(activate(v, p.act));
+  mlp_hidden[m * BN + n - int(gl_WorkGroupID.x) * BN] = VALUE(activate(v, p.act));
 }
+#endif
 
 // Each token's partial sums of x (or of (x - mean)² where `centred`) into norm_partial, then
 // their totals divided by the channels into norm_mean (centred: the inverse deviation into

@@ -57,6 +57,11 @@ const int PAD = 1;
 #endif
 
 const int BM = 16 * TM, BN = 16 * TN, BK = 16;
+#ifdef MLP
+const int PASSES = kMlpHiddenChannels / BM + 1;  // the hidden layer's row blocks, then the second product
+#else
+const int PASSES = 1;
+#endif
 // tile_a's rows padded by one 32-bit word: the 16 invocations that store a column's 16 k values
 // (adjacent in the weights) then write 16 different banks, where a row of 32, 64 or 128 values
 // put them in one or two.
@@ -72,76 +77,84 @@ shared STAGED tile_b[BK][BN];
 void main() {
   const int tx = int(gl_LocalInvocationID.x), ty = int(gl_LocalInvocationID.y);
   const int tid = ty * 16 + tx;
-  const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
   const int col0 = int(gl_WorkGroupID.x) * BN;  // columns of C (output pixels)
-  const int K = gemm_k();
-  // B: each invocation gathers one column (fixed across the K loop) at TN consecutive k of each
-  // step (256 / BN invocations a column, TN k each: the step's 16), followed by a cursor, so no
-  // gathered element divides.
-  const GemmColumn column = gemm_column(col0 + tid % BN);
-  const int b_row = TN * (tid / BN);
-  GemmCursor b_at = gemm_cursor(b_row);
-  const GemmCursor one = gemm_cursor(1), step = gemm_cursor(BK);
+  for (int pass = 0; pass < PASSES; ++pass) {
+#ifdef MLP
+    mlp_phase = pass + 1 < PASSES ? 0 : 1;
+    barrier();  // the hidden layer whole before the second product reads it
+    const int row0 = mlp_phase == 0 ? pass * BM : 0;  // a block of the hidden layer's rows, or all C's
+#else
+    const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
+#endif
+    const int K = gemm_k();
+    // B: each invocation gathers one column (fixed across the K loop) at TN consecutive k of each
+    // step (256 / BN invocations a column, TN k each: the step's 16), followed by a cursor, so no
+    // gathered element divides.
+    const GemmColumn column = gemm_column(col0 + tid % BN);
+    const int b_row = TN * (tid / BN);
+    GemmCursor b_at = gemm_cursor(b_row);
+    const GemmCursor one = gemm_cursor(1), step = gemm_cursor(BK);
 
-  float acc[TM][TN];
-  for (int i = 0; i < TM; ++i)
-    for (int j = 0; j < TN; ++j) acc[i][j] = 0.0;
+    float acc[TM][TN];
+    for (int i = 0; i < TM; ++i)
+      for (int j = 0; j < TN; ++j) acc[i][j] = 0.0;
 
-  // The next step's operands wait in registers while this step's are multiplied (a GPU hides
-  // the global loads' latency behind the arithmetic that way), then go to workgroup memory.
-  float next_a[TM], next_b[TN];
-  for (int r = 0; r < TM; ++r) {
-    const int e = tid + 256 * r;  // A: BM rows × 16 k, adjacent invocations adjacent k
-    next_a[r] = gemm_a(row0 + e / BK, e % BK);
-  }
-  GemmCursor c = b_at;
-  for (int r = 0; r < TN; ++r) {
-    next_b[r] = gemm_b(column, c);
-    gemm_advance(c, one);
-  }
-
-  for (int k0 = 0; k0 < K; k0 += BK) {
+    // The next step's operands wait in registers while this step's are multiplied (a GPU hides
+    // the global loads' latency behind the arithmetic that way), then go to workgroup memory.
+    float next_a[TM], next_b[TN];
     for (int r = 0; r < TM; ++r) {
-      const int e = tid + 256 * r;
-      tile_a[e % BK][e / BK] = STAGED(next_a[r]);
+      const int e = tid + 256 * r;  // A: BM rows × 16 k, adjacent invocations adjacent k
+      next_a[r] = gemm_a(row0 + e / BK, e % BK);
     }
-    for (int r = 0; r < TN; ++r) tile_b[b_row + r][tid % BN] = STAGED(next_b[r]);
-    barrier();
-    if (k0 + BK < K) {
+    GemmCursor c = b_at;
+    for (int r = 0; r < TN; ++r) {
+      next_b[r] = gemm_b(column, c);
+      gemm_advance(c, one);
+    }
+
+    for (int k0 = 0; k0 < K; k0 += BK) {
       for (int r = 0; r < TM; ++r) {
         const int e = tid + 256 * r;
-        next_a[r] = gemm_a(row0 + e / BK, k0 + BK + e % BK);
+        tile_a[e % BK][e / BK] = STAGED(next_a[r]);
       }
-      gemm_advance(b_at, step);
-      c = b_at;
-      for (int r = 0; r < TN; ++r) {
-        next_b[r] = gemm_b(column, c);
-        gemm_advance(c, one);
+      for (int r = 0; r < TN; ++r) tile_b[b_row + r][tid % BN] = STAGED(next_b[r]);
+      barrier();
+      if (k0 + BK < K) {
+        for (int r = 0; r < TM; ++r) {
+          const int e = tid + 256 * r;
+          next_a[r] = gemm_a(row0 + e / BK, k0 + BK + e % BK);
+        }
+        gemm_advance(b_at, step);
+        c = b_at;
+        for (int r = 0; r < TN; ++r) {
+          next_b[r] = gemm_b(column, c);
+          gemm_advance(c, one);
+        }
       }
+      for (int kk = 0; kk < BK; ++kk) {
+        float av[TM], bv[TN];
+        for (int i = 0; i < TM; ++i) av[i] = float(tile_a[kk][ty + 16 * i]);
+        for (int j = 0; j < TN; ++j) bv[j] = float(tile_b[kk][tx + 16 * j]);
+        for (int i = 0; i < TM; ++i)
+          for (int j = 0; j < TN; ++j) acc[i][j] = fma(av[i], bv[j], acc[i][j]);
+      }
+      barrier();
     }
-    for (int kk = 0; kk < BK; ++kk) {
-      float av[TM], bv[TN];
-      for (int i = 0; i < TM; ++i) av[i] = float(tile_a[kk][ty + 16 * i]);
-      for (int j = 0; j < TN; ++j) bv[j] = float(tile_b[kk][tx + 16 * j]);
-      for (int i = 0; i < TM; ++i)
-        for (int j = 0; j < TN; ++j) acc[i][j] = fma(av[i], bv[j], acc[i][j]);
-    }
-    barrier();
-  }
 
 #ifdef CONVEX_UPSAMPLE
-  for (convex_half = 0; convex_half < 2; ++convex_half) {
-    for (int i = 0; i < TM; ++i)
-      for (int j = 0; j < TN; ++j) convex_store(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
-    barrier();
-    convex_upsample_tile(tid, 256);
-    barrier();
-  }
+    for (convex_half = 0; convex_half < 2; ++convex_half) {
+      for (int i = 0; i < TM; ++i)
+        for (int j = 0; j < TN; ++j) convex_store(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+      barrier();
+      convex_upsample_tile(tid, 256);
+      barrier();
+    }
 #else
-  for (int i = 0; i < TM; ++i)
-    for (int j = 0; j < TN; ++j) PRODUCT_STORE(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+    for (int i = 0; i < TM; ++i)
+      for (int j = 0; j < TN; ++j) PRODUCT_STORE(row0 + ty + 16 * i, col0 + tx + 16 * j, acc[i][j]);
+#endif
+  }
 #ifdef LAYER_NORM
   layer_norm_tile(tid, 256);
-#endif
 #endif
 }

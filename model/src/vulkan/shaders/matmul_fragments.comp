@@ -61,7 +61,17 @@ layout(std430, binding = 3) readonly buffer BufD { VALUE d_data[]; };  // the ad
 
 #include "gemm_operands.glsl"
 
-const int BM = 16 * TM, BN = 16 * TN, BK = 32;  // the workgroup's tile and K step
+// The workgroup's tile and K step: 32, but 16 where a LayerNorm epilogue needs workgroup memory.
+#ifdef LAYER_NORM
+const int BM = 16 * TM, BN = 16 * TN, BK = 16;
+#else
+const int BM = 16 * TM, BN = 16 * TN, BK = 32;
+#endif
+#ifdef MLP
+const int PASSES = kMlpHiddenChannels / BM + 1;  // the hidden layer's row blocks, then the second product
+#else
+const int PASSES = 1;
+#endif
 const int F = 16;                               // a fragment: 16×16, K 16
 // With LAYER_NORM the tile is every row of 16 columns (192×16, 4 subgroups down its rows).
 #ifdef LAYER_NORM
@@ -101,97 +111,105 @@ shared float sums[WARPS * F * SC];  // one fragment's sums per subgroup, on thei
 void main() {
   const int tid = int(gl_LocalInvocationIndex);
   const int lane = tid % 32;
-  const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
   const int col0 = int(gl_WorkGroupID.x) * BN;  // columns of C (output pixels)
-  const int K = gemm_k();
-  // B is gathered by column, each invocation the same column through the K loop, at B_RUN
-  // consecutive k of each step, followed by a cursor (no gathered element divides).
-  const int A_LOADS = BM * BK / INVOCATIONS, B_RUN = BK * BN / INVOCATIONS;
-  const GemmColumn column = gemm_column(col0 + tid % BN);
-  const int b_row = B_RUN * (tid / BN);
-  GemmCursor b_at = gemm_cursor(b_row);
-  const GemmCursor one = gemm_cursor(1), step = gemm_cursor(BK);
-#ifdef TENSOR_CORES
-  const int warp = int(gl_SubgroupID);
+  for (int pass = 0; pass < PASSES; ++pass) {
+#ifdef MLP
+    mlp_phase = pass + 1 < PASSES ? 0 : 1;
+    barrier();  // the hidden layer whole before the second product reads it
+    const int row0 = mlp_phase == 0 ? pass * BM : 0;  // a block of the hidden layer's rows, or all C's
 #else
-  const int warp = tid / 32;
+    const int row0 = int(gl_WorkGroupID.y) * BM;  // rows of C (output channels)
 #endif
-  const int warp_row = (warp / WARPS_N) * F * FM, warp_col = (warp % WARPS_N) * F * FN;  // its part of the tile
+    const int K = gemm_k();
+    // B is gathered by column, each invocation the same column through the K loop, at B_RUN
+    // consecutive k of each step, followed by a cursor (no gathered element divides).
+    const int A_LOADS = BM * BK / INVOCATIONS, B_RUN = BK * BN / INVOCATIONS;
+    const GemmColumn column = gemm_column(col0 + tid % BN);
+    const int b_row = B_RUN * (tid / BN);
+    GemmCursor b_at = gemm_cursor(b_row);
+    const GemmCursor one = gemm_cursor(1), step = gemm_cursor(BK);
+#ifdef TENSOR_CORES
+    const int warp = int(gl_SubgroupID);
+#else
+    const int warp = tid / 32;
+#endif
+    const int warp_row = (warp / WARPS_N) * F * FM, warp_col = (warp % WARPS_N) * F * FN;  // its part of the tile
 
 #ifdef TENSOR_CORES
-  SUMS acc[MAX_FM][MAX_FN];
-  for (int i = 0; i < FM; ++i)
-    for (int j = 0; j < FN; ++j) acc[i][j] = SUMS(0.0);
+    SUMS acc[MAX_FM][MAX_FN];
+    for (int i = 0; i < FM; ++i)
+      for (int j = 0; j < FN; ++j) acc[i][j] = SUMS(0.0);
 #else
-  // Invocation `lane` holds rows lane / 16 + 2q, column lane % 16 of each fragment.
-  float acc[FM][FN][8];
-  for (int i = 0; i < FM; ++i)
-    for (int j = 0; j < FN; ++j)
-      for (int q = 0; q < 8; ++q) acc[i][j][q] = 0.0;
+    // Invocation `lane` holds rows lane / 16 + 2q, column lane % 16 of each fragment.
+    float acc[FM][FN][8];
+    for (int i = 0; i < FM; ++i)
+      for (int j = 0; j < FN; ++j)
+        for (int q = 0; q < 8; ++q) acc[i][j][q] = 0.0;
 #endif
 
-  for (int k0 = 0; k0 < K; k0 += BK) {
-    // A: BM rows × 32 k, adjacent invocations read adjacent k (row-major weights).
-    for (int r = 0; r < A_LOADS; ++r) {
-      const int e = tid + INVOCATIONS * r;
-      const int kk = e % BK, mm = e / BK;
-      tile_a[mm * SA + kk] = float16_t(gemm_a(row0 + mm, k0 + kk));
-    }
-    // B: 32 k × BN columns, adjacent invocations read adjacent columns.
-    GemmCursor c = b_at;
-    for (int r = 0; r < B_RUN; ++r) {
-      tile_b[(b_row + r) * SB + tid % BN] = float16_t(gemm_b(column, c));
-      gemm_advance(c, one);
-    }
-    gemm_advance(b_at, step);
-    barrier();
-    for (int kf = 0; kf < BK; kf += F) {
-#ifdef TENSOR_CORES
-      OPERAND a[MAX_FM], b[MAX_FN];
-      for (int i = 0; i < FM; ++i) coopMatLoadNV(a[i], tile_a, (warp_row + F * i) * SA + kf, SA, false);
-      for (int j = 0; j < FN; ++j) coopMatLoadNV(b[j], tile_b, kf * SB + warp_col + F * j, SB, false);
-      for (int i = 0; i < FM; ++i)
-        for (int j = 0; j < FN; ++j) acc[i][j] = coopMatMulAddNV(a[i], b[j], acc[i][j]);
-#else
-      for (int i = 0; i < FM; ++i)
-        for (int j = 0; j < FN; ++j)
-          for (int q = 0; q < 8; ++q) {
-            const int a_row = (warp_row + F * i + lane / 16 + 2 * q) * SA + kf;
-            const int b_col = kf * SB + warp_col + F * j + lane % 16;
-            float s = acc[i][j][q];
-            for (int t = 0; t < F; ++t) s = fma(float(tile_a[a_row + t]), float(tile_b[b_col + t * SB]), s);
-            acc[i][j][q] = s;
-          }
-#endif
-    }
-    barrier();
-  }
-
-  // The sums leave a fragment at a time through workgroup memory, so that the epilogue knows
-  // where each is (a cooperative matrix's layout across invocations is the driver's).
-#ifdef CONVEX_UPSAMPLE
-  for (convex_half = 0; convex_half < 2; ++convex_half) {
-#endif
-  const int out_row = ((tid / 32) / WARPS_N) * F * FM, out_col = ((tid / 32) % WARPS_N) * F * FN;
-  for (int i = 0; i < FM; ++i)
-    for (int j = 0; j < FN; ++j) {
-#ifdef TENSOR_CORES
-      coopMatStoreNV(acc[i][j], sums, warp * F * SC, SC, false);
-#else
-      for (int q = 0; q < 8; ++q) sums[warp * F * SC + (lane / 16 + 2 * q) * SC + lane % 16] = acc[i][j][q];
-#endif
+    for (int k0 = 0; k0 < K; k0 += BK) {
+      // A: BM rows × 32 k, adjacent invocations read adjacent k (row-major weights).
+      for (int r = 0; r < A_LOADS; ++r) {
+        const int e = tid + INVOCATIONS * r;
+        const int kk = e % BK, mm = e / BK;
+        tile_a[mm * SA + kk] = float16_t(gemm_a(row0 + mm, k0 + kk));
+      }
+      // B: 32 k × BN columns, adjacent invocations read adjacent columns.
+      GemmCursor c = b_at;
+      for (int r = 0; r < B_RUN; ++r) {
+        tile_b[(b_row + r) * SB + tid % BN] = float16_t(gemm_b(column, c));
+        gemm_advance(c, one);
+      }
+      gemm_advance(b_at, step);
       barrier();
-      for (int q = 0; q < 8; ++q) {
-        const int r = lane / 16 + 2 * q, c = lane % 16;
-        PRODUCT_STORE(row0 + out_row + F * i + r, col0 + out_col + F * j + c, sums[(tid / 32) * F * SC + r * SC + c]);
+      for (int kf = 0; kf < BK; kf += F) {
+#ifdef TENSOR_CORES
+        OPERAND a[MAX_FM], b[MAX_FN];
+        for (int i = 0; i < FM; ++i) coopMatLoadNV(a[i], tile_a, (warp_row + F * i) * SA + kf, SA, false);
+        for (int j = 0; j < FN; ++j) coopMatLoadNV(b[j], tile_b, kf * SB + warp_col + F * j, SB, false);
+        for (int i = 0; i < FM; ++i)
+          for (int j = 0; j < FN; ++j) acc[i][j] = coopMatMulAddNV(a[i], b[j], acc[i][j]);
+#else
+        for (int i = 0; i < FM; ++i)
+          for (int j = 0; j < FN; ++j)
+            for (int q = 0; q < 8; ++q) {
+              const int a_row = (warp_row + F * i + lane / 16 + 2 * q) * SA + kf;
+              const int b_col = kf * SB + warp_col + F * j + lane % 16;
+              float s = acc[i][j][q];
+              for (int t = 0; t < F; ++t) s = fma(float(tile_a[a_row + t]), float(tile_b[b_col + t * SB]), s);
+              acc[i][j][q] = s;
+            }
+#endif
       }
       barrier();
     }
+
+    // The sums leave a fragment at a time through workgroup memory, so that the epilogue knows
+    // where each is (a cooperative matrix's layout across invocations is the driver's).
 #ifdef CONVEX_UPSAMPLE
-    convex_upsample_tile(tid, INVOCATIONS);
-    barrier();
-  }
+    for (convex_half = 0; convex_half < 2; ++convex_half) {
 #endif
+    const int out_row = ((tid / 32) / WARPS_N) * F * FM, out_col = ((tid / 32) % WARPS_N) * F * FN;
+    for (int i = 0; i < FM; ++i)
+      for (int j = 0; j < FN; ++j) {
+#ifdef TENSOR_CORES
+        coopMatStoreNV(acc[i][j], sums, warp * F * SC, SC, false);
+#else
+        for (int q = 0; q < 8; ++q) sums[warp * F * SC + (lane / 16 + 2 * q) * SC + lane % 16] = acc[i][j][q];
+#endif
+        barrier();
+        for (int q = 0; q < 8; ++q) {
+          const int r = lane / 16 + 2 * q, c = lane % 16;
+          PRODUCT_STORE(row0 + out_row + F * i + r, col0 + out_col + F * j + c, sums[(tid / 32) * F * SC + r * SC + c]);
+        }
+        barrier();
+      }
+#ifdef CONVEX_UPSAMPLE
+      convex_upsample_tile(tid, INVOCATIONS);
+      barrier();
+    }
+#endif
+  }
 #ifdef LAYER_NORM
   layer_norm_tile(tid, INVOCATIONS);
 #endif
