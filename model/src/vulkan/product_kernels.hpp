@@ -53,8 +53,7 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
     case Shader::conv2d_convex: return cores ? Shader::conv2d_convex_coopmat : Shader::conv2d_convex_coopmat_twin;
     case Shader::matmul: return cores ? Shader::matmul_coopmat : Shader::matmul_coopmat_twin;
     case Shader::matmul_norm: return cores ? Shader::matmul_norm_coopmat : Shader::matmul_norm_coopmat_twin;
-    case Shader::matmul_mlp_norm:
-      return cores ? Shader::matmul_mlp_norm_coopmat : Shader::matmul_mlp_norm_coopmat_twin;
+    case Shader::matmul_mlp_norm: return cores ? Shader::matmul_mlp_norm_coopmat : Shader::matmul_mlp_norm_coopmat_twin;
     case Shader::winograd_gemm: return cores ? Shader::winograd_gemm_coopmat : Shader::winograd_gemm_coopmat_twin;
     case Shader::winograd_conv: return cores ? Shader::winograd_conv_coopmat : Shader::winograd_conv_coopmat_twin;
     case Shader::winograd_conv_parts:
@@ -70,9 +69,9 @@ inline Shader product_shader(Shader scalar, ProductKernels kernels) {
 // Whether a network whose products run on `kernels` records `shader`: every shader but the
 // other kernels' products.
 inline bool records(Shader shader, ProductKernels kernels) {
-  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::matmul_norm, Shader::matmul_mlp_norm, Shader::winograd_gemm,
-                              Shader::winograd_conv, Shader::winograd_conv_parts, Shader::winograd_conv_step,
-                              Shader::winograd_conv_step_end, Shader::conv2d_convex}) {
+  for (const Shader scalar : {Shader::conv2d, Shader::matmul, Shader::matmul_norm, Shader::matmul_mlp_norm,
+                              Shader::winograd_gemm, Shader::winograd_conv, Shader::winograd_conv_parts,
+                              Shader::winograd_conv_step, Shader::winograd_conv_step_end, Shader::conv2d_convex}) {
     for (const ProductKernels k : {ProductKernels::scalar, ProductKernels::tensor_cores, ProductKernels::twin}) {
       if (product_shader(scalar, k) == shader) return k == kernels;
     }
