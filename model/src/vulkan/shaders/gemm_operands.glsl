@@ -20,9 +20,9 @@
 // (rounded to the stored type, as the first product would have stored it); in phase 1
 // W2 · hidden, which the LayerNorm epilogue takes. The hidden layer's memory then holds the
 // second product's values for the LayerNorm (layer_norm_tile.glsl).
-shared VALUE mlp_hidden[kMlpHiddenChannels * 16 * TN];  // [hidden channel][column of the tile]
+shared VALUE mlp_hidden[kMlpHiddenChannels * 16];  // [hidden channel][column of the tile, of 16]
 int mlp_phase = 0;
-int mlp_col0() { return int(gl_WorkGroupID.x) * 16 * TN; }
+int mlp_col0() { return int(gl_WorkGroupID.x) * 16; }
 #endif
 
 #ifdef IMPLICIT_CONV
@@ -130,7 +130,7 @@ float gemm_b(GemmColumn col, GemmCursor c) {
 #elif defined(WINOGRAD_GEMM)
   return b_data[(int(gl_WorkGroupID.z) * gemm_k() + c.k) * gemm_n() + col.n];
 #elif defined(MLP)
-  if (mlp_phase == 1) return float(mlp_hidden[c.k * 16 * TN + col.n - mlp_col0()]);
+  if (mlp_phase == 1) return float(mlp_hidden[c.k * 16 + col.n - mlp_col0()]);
   return float(b_data[p.b_off + c.k * p.b_rs + col.n * p.b_cs]);
 #else
   return float(b_data[p.b_off + c.k * p.b_rs + col.n * p.b_cs]);

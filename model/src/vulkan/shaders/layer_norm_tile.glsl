@@ -11,10 +11,12 @@ const int NORM_LANES = 16;
 #ifdef MLP
 #define normed mlp_hidden  // free again once the second product has read it
 #else
-shared VALUE normed[BM * BN];  // [row][column of the tile]
+shared VALUE normed[kMatmulNormChannels * 16];  // [row][column of the tile]
 #endif
-shared float norm_partial[NORM_LANES * BN];
-shared float norm_mean[BN], norm_inv[BN];
+// Sized as the tile is, 192×16 (BM × BN), in plain constants: a validation layer may size
+// arrays by the specialization constants' defaults, or misjudge them.
+shared float norm_partial[NORM_LANES * 16];
+shared float norm_mean[16], norm_inv[16];
 
 // C[m][n] from its sum of products, before the LayerNorm: scale, bias and activation.
 void norm_stage(int m, int n, float sum) {

@@ -12,8 +12,15 @@
 // as its epilogue (LAYER_NORM, layer_norm_tile.glsl: 192×16 tiles). Every device runs it;
 // matmul_fragments.comp is the tensor-core path of the same products.
 layout(local_size_x = 16, local_size_y = 16) in;
+// A LayerNorm epilogue's tile, 192×16, is also the defaults: the validation layer sizes
+// workgroup memory by them.
+#ifdef LAYER_NORM
+layout(constant_id = 0) const int TM = 12;
+layout(constant_id = 1) const int TN = 1;
+#else
 layout(constant_id = 0) const int TM = 4;  // outputs per invocation along M (rows of C)
 layout(constant_id = 1) const int TN = 4;  // and along N (columns of C): 1, 2, 4, 8 or 16
+#endif
 
 layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
 #ifdef WINOGRAD_GEMM

@@ -28,8 +28,15 @@
 // constant the code reads are two specialization constants set alike: a driver may read
 // gl_WorkGroupSize at run time (lavapipe does, and then nothing sized by it unrolls).
 layout(local_size_x = 128, local_size_x_id = 3) in;
+// A LayerNorm epilogue's tile, 192×16, is also the defaults: the validation layer sizes
+// workgroup memory by them.
+#ifdef LAYER_NORM
+layout(constant_id = 0) const int TM = 12;
+layout(constant_id = 1) const int TN = 1;
+#else
 layout(constant_id = 0) const int TM = 4;  // the tile: BM = 16·TM rows of C
 layout(constant_id = 1) const int TN = 4;  // and BN = 16·TN columns
+#endif
 layout(constant_id = 2) const int INVOCATIONS = 128;
 
 layout(std430, binding = 0) readonly buffer BufA { VALUE a_data[]; };
