@@ -4,26 +4,40 @@
 
 namespace neuflow::model::vulkan {
 
+namespace {
+
+// The members of MatmulParams that MatmulNormParams shares: `w` times the token list `in`
+// [features][tokens] into `m` rows of `out` (a product's output, or the LayerNorm's after it).
+template <typename Params>
+Params token_product(const DeviceLinear& w, int m, const View& in, const View& out, Activation act) {
+  const int tokens = in.h * in.w;
+  Params p{};
+  p.m = m;
+  p.n = tokens;
+  p.k = w.in_features;
+  p.a_off = w.weight.offset;
+  p.a_rs = w.in_features;
+  p.a_cs = 1;
+  p.b_off = in.offset();
+  p.b_rs = tokens;
+  p.b_cs = 1;
+  p.c_off = out.offset();
+  p.c_rs = tokens;
+  p.c_cs = 1;
+  p.bias_off = w.bias.offset;
+  p.act = activation_code(act);
+  p.alpha = 1.f;
+  return p;
+}
+
+}  // namespace
+
 // Token lists [features][tokens]: out = act(W · in + b).
 void record_op(Recorder& r, const graph::Linear<DeviceTensor>& op) {
   const DeviceLinear& w = *op.weights;
   const View in = r.view(op.in), out = r.view(op.out);
   const int tokens = in.h * in.w;
-  const MatmulParams p{w.out_features,
-                       tokens,
-                       w.in_features,
-                       w.weight.offset,
-                       w.in_features,
-                       1,
-                       in.offset(),
-                       tokens,
-                       1,
-                       out.offset(),
-                       tokens,
-                       1,
-                       w.bias.offset,
-                       activation_code(op.act),
-                       1.f};
+  const auto p = token_product<MatmulParams>(w, w.out_features, in, out, op.act);
   const long long weights = static_cast<long long>(w.out_features) * w.in_features;
   const long long read = weights + (w.bias.offset >= 0 ? w.out_features : 0) + in.count();
   r.product<Shader::matmul>({&r.weights(), in.buffer, out.buffer, nullptr}, p,
@@ -51,32 +65,18 @@ void record_norm_epilogue(Recorder& r, const graph::Linear<DeviceTensor>& first,
   const View out2 = unstacked ? r.view(unstacked->frames[1]) : View{};
   const View residual = norm.residual ? r.view(*norm.residual) : View{};
   const int tokens = in.h * in.w;
-  const MatmulNormParams p{last.out_features,
-                           tokens,
-                           w.in_features,
-                           w.weight.offset,
-                           w.in_features,
-                           1,
-                           in.offset(),
-                           tokens,
-                           1,
-                           out.offset(),
-                           tokens,
-                           1,
-                           w.bias.offset,
-                           activation_code(first.act),
-                           1.f,
-                           norm.residual ? residual.offset() : -1,
-                           norm.weights->gamma.offset,
-                           norm.weights->beta.offset,
-                           then ? then->scale->offset : -1,
-                           then ? then->shift->offset : -1,
-                           unstacked ? tokens / 2 : 0,
-                           unstacked ? out2.offset() : 0,
-                           second ? kMlpHiddenChannels : 0,
-                           second ? last.weight.offset : -1,
-                           second ? last.bias.offset : -1,
-                           second ? activation_code(second->act) : 0};
+  auto p = token_product<MatmulNormParams>(w, last.out_features, in, out, first.act);
+  p.res_off = norm.residual ? residual.offset() : -1;
+  p.gamma_off = norm.weights->gamma.offset;
+  p.beta_off = norm.weights->beta.offset;
+  p.scale_off = then ? then->scale->offset : -1;
+  p.shift_off = then ? then->shift->offset : -1;
+  p.split = unstacked ? tokens / 2 : 0;
+  p.out2_off = unstacked ? out2.offset() : 0;
+  p.hidden = second ? kMlpHiddenChannels : 0;
+  p.w2_off = second ? last.weight.offset : -1;
+  p.bias2_off = second ? last.bias.offset : -1;
+  p.act2 = second ? activation_code(second->act) : 0;
   const auto weights_of = [](const DeviceLinear& l) {
     return static_cast<long long>(l.out_features) * l.in_features + (l.bias.offset >= 0 ? l.out_features : 0);
   };
