@@ -29,6 +29,12 @@ bool near(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b, int 
 
 bool live_at_once(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b) { return near(a, b, 0); }
 
+void stretch_live_range(LiveRanges& ranges, TensorId tensor, int read_at, int last) {
+  for (LiveRange& r : ranges[static_cast<std::size_t>(tensor)]) {
+    if (r.first <= read_at && read_at <= r.last) r.last = std::max(r.last, last);
+  }
+}
+
 OffsetPlan plan_offsets(const std::vector<std::size_t>& bytes, const LiveRanges& ranges, std::size_t alignment) {
   OffsetPlan plan;
   plan.offset.assign(bytes.size(), 0);

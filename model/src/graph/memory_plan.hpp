@@ -53,6 +53,10 @@ template <typename Name>
 void check_offsets(const OffsetPlan& plan, const std::vector<std::size_t>& bytes, const LiveRanges& ranges,
                    const Name& name);
 
+// `tensor`'s range that holds op `read_at` made to last until op `last` at least: for a backend
+// that reads the tensor later than the graph's order says (a fused dispatch).
+void stretch_live_range(LiveRanges& ranges, TensorId tensor, int read_at, int last);
+
 // Whether two tensors' ranges meet.
 bool live_at_once(const std::vector<LiveRange>& a, const std::vector<LiveRange>& b);
 

@@ -103,10 +103,7 @@ void extend_live_ranges(graph::LiveRanges& ranges, const graph::OpList<DeviceTen
     const int last = first_op + static_cast<int>(found->readers.back());
     for (std::size_t p = 0; p < found->writers.size(); ++p) {
       const graph::Resample& part = p == 0 ? found->parts.first : *found->parts.second;
-      const int read_at = first_op + static_cast<int>(found->writers[p]);
-      for (graph::LiveRange& r : ranges[static_cast<std::size_t>(part.in.tensor)]) {
-        if (r.first <= read_at && read_at <= r.last) r.last = std::max(r.last, last);
-      }
+      graph::stretch_live_range(ranges, part.in.tensor, first_op + static_cast<int>(found->writers[p]), last);
     }
   }
 }
@@ -133,10 +130,8 @@ void keep_conv3_inputs_to_step_ends(graph::LiveRanges& ranges, const graph::OpLi
     const std::size_t j = after_stage_ends(i + 1);
     const bool joined = j < ops.size() && (std::holds_alternative<graph::LocalCorrelation>(ops[j].op) ||
                                            as_resample(ops[j].op).has_value());
-    const int read_at = first_op + static_cast<int>(k - 1), last = first_op + static_cast<int>(joined ? j : i);
-    for (graph::LiveRange& r : ranges[static_cast<std::size_t>(conv3->in.tensor)]) {
-      if (r.first <= read_at && read_at <= r.last) r.last = std::max(r.last, last);
-    }
+    graph::stretch_live_range(ranges, conv3->in.tensor, first_op + static_cast<int>(k - 1),
+                              first_op + static_cast<int>(joined ? j : i));
   }
 }
 

@@ -44,10 +44,8 @@ void keep_product_inputs_to_norms(graph::LiveRanges& ranges, const graph::OpList
     if (!norm) norm = norm_after_mlp(ops, tensors, i);
     if (!norm) continue;
     const auto& product = std::get<graph::Linear<DeviceTensor>>(ops[i].op);
-    const int read_at = first_op + static_cast<int>(i), last = first_op + static_cast<int>(*norm);
-    for (graph::LiveRange& r : ranges[static_cast<std::size_t>(product.in.tensor)]) {
-      if (r.first <= read_at && read_at <= r.last) r.last = std::max(r.last, last);
-    }
+    graph::stretch_live_range(ranges, product.in.tensor, first_op + static_cast<int>(i),
+                              first_op + static_cast<int>(*norm));
   }
 }
 

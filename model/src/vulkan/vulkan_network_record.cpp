@@ -72,8 +72,8 @@ struct Fusions {
   std::vector<bool> pyramid;                                                   // starts here
   std::vector<std::optional<graph::Resample>> concat_first;                    // of a resample
   std::vector<std::optional<graph::Resample>> resample_after;                  // of a RefineUpdate
-  std::vector<std::optional<std::size_t>> norm_after;                          // of a Linear
-  std::vector<std::optional<std::size_t>> mlp_norm_after;                      // of a Linear
+  // Of a Linear: its LayerNorm's index, i + 1, or i + 2 where ops[i + 1] is the MLP's second layer.
+  std::vector<std::optional<std::size_t>> norm_after;
 };
 
 // The resample after ops[i] that writes the channels right after its output's, with nothing
@@ -256,7 +256,6 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
             std::vector<bool>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
             std::vector<std::optional<graph::Resample>>(ops.size()),
-            std::vector<std::optional<std::size_t>>(ops.size()),
             std::vector<std::optional<std::size_t>>(ops.size())};
   for (std::size_t i = 0; i < ops.size(); ++i) {
     if (!f.absorbed[i]) find_input_in_parts(ops, tensors, i, r, f);
@@ -333,27 +332,21 @@ Fusions find_fusions(const graph::OpList<DeviceTensor>& ops, const graph::Tensor
     }
   }
   // After the others: the LayerNorm's folded BatchNorm and unstacked output are its own fusions.
-  // An MLP's two layers with it first (in fp16), where neither layer's output is read elsewhere.
+  // In fp16 an MLP's two layers with it, else the one product before it, where no product's
+  // output is read elsewhere.
   for (std::size_t i = 0; i < ops.size(); ++i) {
-    const auto j = f.absorbed[i] || !r.fp16() ? std::nullopt : norm_after_mlp(ops, tensors, i);
-    if (!j || f.absorbed[i + 1] || f.absorbed[*j]) continue;
-    const auto& first = std::get<graph::Linear<DeviceTensor>>(ops[i].op);
-    const auto& second = std::get<graph::Linear<DeviceTensor>>(ops[i + 1].op);
-    if (read_after(ops, i + 1, first.out.tensor, r.observing()) ||
-        read_after(ops, *j, second.out.tensor, r.observing())) {
-      continue;
-    }
-    check_norm_output_apart(r, first, std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op), f.unstacked[*j]);
-    f.absorbed[i + 1] = f.absorbed[*j] = true;
-    f.mlp_norm_after[i] = j;
-  }
-  for (std::size_t i = 0; i < ops.size(); ++i) {
-    const auto j = f.absorbed[i] ? std::nullopt : norm_after_product(ops, tensors, i);
-    if (!j || f.absorbed[*j]) continue;
-    const auto& product = std::get<graph::Linear<DeviceTensor>>(ops[i].op);
-    if (read_after(ops, *j, product.out.tensor, r.observing())) continue;
-    check_norm_output_apart(r, product, std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op), f.unstacked[*j]);
-    f.absorbed[*j] = true;
+    if (f.absorbed[i]) continue;
+    const auto unread = [&](std::size_t product, std::size_t until) {
+      return !f.absorbed[until] &&
+             !read_after(ops, until, std::get<graph::Linear<DeviceTensor>>(ops[product].op).out.tensor, r.observing());
+    };
+    auto j = r.fp16() ? norm_after_mlp(ops, tensors, i) : std::nullopt;
+    if (j && !(unread(i, i + 1) && unread(i + 1, *j))) j.reset();
+    if (!j) j = norm_after_product(ops, tensors, i);
+    if (!j || !unread(*j - 1, *j)) continue;
+    check_norm_output_apart(r, std::get<graph::Linear<DeviceTensor>>(ops[i].op),
+                            std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op), f.unstacked[*j]);
+    for (std::size_t k = i + 1; k <= *j; ++k) f.absorbed[k] = true;
     f.norm_after[i] = j;
   }
   return f;
@@ -403,13 +396,16 @@ void VulkanNetwork::record(Recorder& r, const graph::OpList<DeviceTensor>& ops) 
       record_op(r, std::get<graph::LocalCorrelation>(op), *f.start_first[i].first, *f.start_first[i].second);
     } else if (const auto* norm = std::get_if<graph::LayerNorm<DeviceTensor>>(&op)) {
       record_op(r, *norm, f.affine_after[i], f.unstacked[i] ? &*f.unstacked[i] : nullptr);
-    } else if (const auto k = f.mlp_norm_after[i]) {
-      record_op(r, std::get<graph::Linear<DeviceTensor>>(op), std::get<graph::Linear<DeviceTensor>>(ops[i + 1].op),
-                std::get<graph::LayerNorm<DeviceTensor>>(ops[*k].op), f.affine_after[*k],
-                f.unstacked[*k] ? &*f.unstacked[*k] : nullptr);
     } else if (const auto j = f.norm_after[i]) {
-      record_op(r, std::get<graph::Linear<DeviceTensor>>(op), std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op),
-                f.affine_after[*j], f.unstacked[*j] ? &*f.unstacked[*j] : nullptr);
+      const auto& product = std::get<graph::Linear<DeviceTensor>>(op);
+      const auto& normalize = std::get<graph::LayerNorm<DeviceTensor>>(ops[*j].op);
+      const auto* unstacked = f.unstacked[*j] ? &*f.unstacked[*j] : nullptr;
+      if (*j == i + 2) {
+        record_op(r, product, std::get<graph::Linear<DeviceTensor>>(ops[i + 1].op), normalize, f.affine_after[*j],
+                  unstacked);
+      } else {
+        record_op(r, product, normalize, f.affine_after[*j], unstacked);
+      }
     } else if (f.conv3_before_end[i]) {
       record_op(r, *f.conv3_before_end[i], std::get<graph::RefineUpdate>(op),
                 f.resample_after[i] ? &*f.resample_after[i] : nullptr);
